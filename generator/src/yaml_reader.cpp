@@ -1,0 +1,1016 @@
+#include "mbsgen/generator/yaml_reader.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+namespace mbsgen {
+
+namespace detail {
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  // Optimal string alignment distance: Levenshtein plus transposition of adjacent characters.
+  const std::size_t n = a.size(), m = b.size();
+  std::vector<std::vector<std::size_t>> d(n + 1, std::vector<std::size_t>(m + 1, 0));
+  for (std::size_t i = 0; i <= n; ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= m; ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= n; ++i)
+    for (std::size_t j = 1; j <= m; ++j) {
+      const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[n][m];
+}
+
+}  // namespace detail
+
+namespace {
+
+// " (did you mean 'x'?)" for the closest candidate within a small edit distance, else "".
+std::string suggestion(const std::string& word, const std::vector<std::string>& candidates) {
+  const std::size_t limit = word.size() <= 3 ? 1 : word.size() <= 6 ? 2 : 3;
+  std::size_t best = limit + 1;
+  std::string best_name;
+  for (const auto& c : candidates) {
+    const std::size_t d = detail::edit_distance(word, c);
+    if (d < best) {
+      best = d;
+      best_name = c;
+    }
+  }
+  return best_name.empty() ? std::string() : " (did you mean '" + best_name + "'?)";
+}
+
+std::string join(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Expressions: a small lexer and recursive-descent checker that mirrors GiNaC's grammar and knows
+// where each token is, so that errors point at a character; the checked text, with decimal
+// literals rewritten as exact rationals, is then parsed by GiNaC::parser (strict).
+
+using detail::ExpressionError;
+
+// What an expression may depend on.
+enum class Scope { constants, parameters, positions, no_inputs, any };
+
+enum class SymbolKind { parameter, coordinate, rate, input };
+
+const char* kind_name(SymbolKind k) {
+  switch (k) {
+    case SymbolKind::parameter: return "a parameter";
+    case SymbolKind::coordinate: return "a coordinate";
+    case SymbolKind::rate: return "a coordinate rate";
+    case SymbolKind::input: return "an input";
+  }
+  return "a symbol";
+}
+
+bool in_scope(SymbolKind k, Scope s) {
+  switch (s) {
+    case Scope::constants: return false;
+    case Scope::parameters: return k == SymbolKind::parameter;
+    case Scope::positions: return k == SymbolKind::parameter || k == SymbolKind::coordinate;
+    case Scope::no_inputs: return k != SymbolKind::input;
+    case Scope::any: return true;
+  }
+  return false;
+}
+
+const char* scope_phrase(Scope s) {
+  switch (s) {
+    case Scope::constants: return "must be a constant (numbers, Pi and functions only)";
+    case Scope::parameters: return "may depend on parameters only";
+    case Scope::positions: return "may depend on parameters and coordinates only (no rates or inputs)";
+    case Scope::no_inputs: return "may not depend on inputs";
+    case Scope::any: return "";
+  }
+  return "";
+}
+
+const std::vector<std::string>& known_functions() {
+  static const std::vector<std::string> names = {
+      "abs",  "acos", "acosh", "asin", "asinh", "atan", "atan2", "atanh", "cos",
+      "cosh", "exp",  "log",   "pow",  "sin",   "sinh", "sqrt",  "tan",   "tanh"};
+  return names;
+}
+
+struct Token {
+  enum class Kind { number, identifier, op, end };
+  Kind kind;
+  std::string text;
+  std::size_t pos;
+};
+
+bool is_ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+bool is_digit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
+
+std::vector<Token> lex(const std::string& s) {
+  std::vector<Token> out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const char c = s[i];
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r') {
+      ++i;
+    } else if (is_ident_start(c)) {
+      std::size_t j = i + 1;
+      while (j < s.size() && is_ident_char(s[j])) ++j;
+      out.push_back({Token::Kind::identifier, s.substr(i, j - i), i});
+      i = j;
+    } else if (is_digit(c) || c == '.') {
+      std::size_t j = i, digits = 0;
+      while (j < s.size() && is_digit(s[j])) ++j, ++digits;
+      if (j < s.size() && s[j] == '.') {
+        ++j;
+        while (j < s.size() && is_digit(s[j])) ++j, ++digits;
+      }
+      bool ok = digits > 0;
+      if (ok && j < s.size() && (s[j] == 'e' || s[j] == 'E')) {
+        std::size_t k = j + 1;
+        if (k < s.size() && (s[k] == '+' || s[k] == '-')) ++k;
+        std::size_t exp_digits = 0;
+        while (k < s.size() && is_digit(s[k])) ++k, ++exp_digits;
+        ok = exp_digits > 0;
+        j = k;
+      }
+      if (ok && j < s.size() && (s[j] == '.' || is_ident_char(s[j]))) {
+        // "1.2.3", "2x", "1e5x": a number glued to something else.
+        while (j < s.size() && (s[j] == '.' || is_ident_char(s[j]))) ++j;
+        ok = false;
+      }
+      if (!ok) throw ExpressionError(i, "malformed number '" + s.substr(i, j - i) + "'");
+      out.push_back({Token::Kind::number, s.substr(i, j - i), i});
+      i = j;
+    } else if (std::string("+-*/^(),").find(c) != std::string::npos) {
+      out.push_back({Token::Kind::op, std::string(1, c), i});
+      ++i;
+    } else {
+      std::string shown(1, c);
+      if (static_cast<unsigned char>(c) >= 0x80) shown = "non-ASCII character";
+      throw ExpressionError(i, "unexpected character '" + shown + "' in an expression");
+    }
+  }
+  out.push_back({Token::Kind::end, "", s.size()});
+  return out;
+}
+
+// A decimal literal as an exact integer or rational ("0.25" → "(25/100)", "1e-6" → "(1/1000000)").
+std::string exact_number(const Token& t) {
+  const std::string& s = t.text;
+  std::size_t epos = s.find_first_of("eE");
+  const std::string mantissa = s.substr(0, epos);
+  long exponent = 0;
+  if (epos != std::string::npos) {
+    std::string e = s.substr(epos + 1);
+    bool negative = false;
+    if (!e.empty() && (e[0] == '+' || e[0] == '-')) {
+      negative = e[0] == '-';
+      e.erase(0, 1);
+    }
+    e.erase(0, std::min(e.find_first_not_of('0'), e.size()));
+    if (e.size() > 4) throw ExpressionError(t.pos, "exponent out of range in '" + s + "'");
+    exponent = e.empty() ? 0 : std::stol(e);
+    if (negative) exponent = -exponent;
+  }
+  std::string digits = mantissa;
+  const std::size_t dot = digits.find('.');
+  if (dot != std::string::npos) {
+    exponent -= static_cast<long>(digits.size() - dot - 1);
+    digits.erase(dot, 1);
+  }
+  digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size()));
+  if (digits.empty()) return "0";
+  if (exponent >= 0) return digits + std::string(static_cast<std::size_t>(exponent), '0');
+  return "(" + digits + "/1" + std::string(static_cast<std::size_t>(-exponent), '0') + ")";
+}
+
+// Checks the token stream against GiNaC's expression grammar:
+//   expr := unary (('+'|'-'|'*'|'/'|'^') unary)*     unary := ('+'|'-')* primary
+//   primary := number | name | function '(' [expr (',' expr)*] ')' | '(' expr ')'
+class ExpressionChecker {
+ public:
+  using SymbolCheck = std::function<void(const Token&)>;
+  ExpressionChecker(const std::vector<Token>& tokens, SymbolCheck check)
+      : t_(tokens), check_(std::move(check)) {}
+
+  void run() {
+    if (t_.front().kind == Token::Kind::end) throw ExpressionError(0, "empty expression");
+    expr();
+    const Token& tok = t_[i_];
+    if (tok.kind == Token::Kind::end) return;
+    if (tok.text == ")") throw ExpressionError(tok.pos, "unmatched ')'");
+    if (tok.text == ",") throw ExpressionError(tok.pos, "unexpected ','");
+    throw ExpressionError(tok.pos, "expected an operator before '" + tok.text +
+                                       "' (multiplication is written '*')");
+  }
+
+ private:
+  bool is_op(const char* ops) const {
+    const Token& tok = t_[i_];
+    return tok.kind == Token::Kind::op && std::string(ops).find(tok.text[0]) != std::string::npos;
+  }
+
+  void expr() {
+    unary();
+    while (is_op("+-*/^")) {
+      ++i_;
+      unary();
+    }
+  }
+
+  void unary() {
+    while (is_op("+-")) ++i_;
+    primary();
+  }
+
+  void primary() {
+    const Token& tok = t_[i_];
+    switch (tok.kind) {
+      case Token::Kind::number: ++i_; return;
+      case Token::Kind::identifier:
+        ++i_;
+        if (is_op("(")) {
+          call(tok);
+        } else {
+          check_(tok);
+        }
+        return;
+      case Token::Kind::op:
+        if (tok.text == "(") {
+          ++i_;
+          expr();
+          if (!is_op(")")) throw ExpressionError(t_[i_].pos, "expected ')'");
+          ++i_;
+          return;
+        }
+        if (tok.text == "*" && i_ > 0 && t_[i_ - 1].text == "*")
+          throw ExpressionError(tok.pos, "unexpected '*' (powers are written '^')");
+        throw ExpressionError(tok.pos, "expected an operand, got '" + tok.text + "'");
+      case Token::Kind::end: break;
+    }
+    throw ExpressionError(tok.pos, "unexpected end of expression");
+  }
+
+  void call(const Token& name) {
+    const auto& fns = known_functions();
+    if (!std::binary_search(fns.begin(), fns.end(), name.text))
+      throw ExpressionError(name.pos, "unknown function '" + name.text + "'" +
+                                          suggestion(name.text, fns));
+    ++i_;  // '('
+    std::size_t args = 0;
+    if (!is_op(")")) {
+      while (true) {
+        expr();
+        ++args;
+        if (is_op(")")) break;
+        if (!is_op(","))
+          throw ExpressionError(t_[i_].pos, "expected ',' or ')' in the arguments of '" +
+                                                name.text + "'");
+        ++i_;
+      }
+    }
+    ++i_;  // ')'
+    const auto& table = GiNaC::get_default_reader();
+    if (table.find(GiNaC::prototype(name.text, args)) == table.end()) {
+      const std::size_t want = name.text == "atan2" || name.text == "pow" ? 2 : 1;
+      throw ExpressionError(name.pos, "function '" + name.text + "' takes " +
+                                          std::to_string(want) + " argument" +
+                                          (want == 1 ? "" : "s") + ", got " +
+                                          std::to_string(args));
+    }
+  }
+
+  const std::vector<Token>& t_;
+  SymbolCheck check_;
+  std::size_t i_ = 0;
+};
+
+GiNaC::ex parse_checked(const Model& model, const std::string& text,
+                        const ExpressionChecker::SymbolCheck& check_known) {
+  const std::vector<Token> tokens = lex(text);
+  auto check = [&](const Token& tok) {
+    if (tok.text == "Pi" || tok.text == "Euler" || tok.text == "Catalan") return;
+    if (tok.text == "I")
+      throw ExpressionError(tok.pos, "the imaginary unit 'I' is not allowed in a model");
+    const GiNaC::symtab& table = model.symbol_table();
+    if (table.find(tok.text) == table.end()) {
+      std::vector<std::string> names;
+      for (const auto& [name, sym] : table) names.push_back(name);
+      throw ExpressionError(tok.pos, "unknown symbol '" + tok.text + "'" +
+                                         suggestion(tok.text, names));
+    }
+    if (check_known) check_known(tok);
+  };
+  ExpressionChecker(tokens, check).run();
+
+  std::string rewritten;
+  for (const auto& tok : tokens) {
+    if (tok.kind == Token::Kind::end) break;
+    rewritten += tok.kind == Token::Kind::number ? exact_number(tok) : tok.text;
+    rewritten += ' ';
+  }
+  try {
+    GiNaC::parser reader(model.symbol_table());
+    reader.strict = true;
+    return reader(rewritten);
+  } catch (const std::exception& e) {
+    // Not expected after the checks above; report GiNaC's own words at the expression.
+    throw ExpressionError(0, std::string("bad expression: ") + e.what());
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The YAML reader.
+
+struct Entry {
+  YAML::Node key;
+  YAML::Node value;
+};
+
+std::string describe(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Null: return "nothing";
+    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
+    case YAML::NodeType::Sequence: return "a list";
+    case YAML::NodeType::Map: return "a map";
+    case YAML::NodeType::Undefined: break;
+  }
+  return "nothing";
+}
+
+bool is_identifier(const std::string& s) {
+  if (s.empty() || !std::isalpha(static_cast<unsigned char>(s[0]))) return false;
+  return std::all_of(s.begin(), s.end(), is_ident_char);
+}
+
+Mat3 multiply(const Mat3& a, const Mat3& b) {
+  Mat3 c = zero_mat3();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      GiNaC::ex s = 0;
+      for (int k = 0; k < 3; ++k) s += a[i][k] * b[k][j];
+      c[i][j] = s;
+    }
+  return c;
+}
+
+// The rotation matrix of an elementary rotation (maps components in the rotated frame to the
+// frame it is applied in).
+Mat3 rotation_matrix(const ElementaryRotation& r) {
+  const GiNaC::ex c = GiNaC::cos(r.angle), s = GiNaC::sin(r.angle);
+  Mat3 m = identity_mat3();
+  int i = 0, j = 0;
+  switch (r.axis) {
+    case Axis::x: i = 1, j = 2; break;
+    case Axis::y: i = 2, j = 0; break;
+    case Axis::z: i = 0, j = 1; break;
+  }
+  m[i][i] = c;
+  m[i][j] = -s;
+  m[j][i] = s;
+  m[j][j] = c;
+  return m;
+}
+
+class Reader {
+ public:
+  Reader(const std::string& text, const std::string& file) : text_(text), file_(file) {}
+
+  Model read();
+
+ private:
+  using Fields = std::map<std::string, Entry>;
+
+  SourceLocation loc(const YAML::Node& n) const {
+    const YAML::Mark m = n.Mark();
+    if (m.line < 0) return {file_, 0, 0};
+    return {file_, m.line + 1, m.column + 1};
+  }
+
+  // The location of character `offset` of a scalar, when the scalar is written on one line
+  // without escapes (plain or quoted); the scalar's own location otherwise.
+  SourceLocation loc_in_scalar(const YAML::Node& n, std::size_t offset) const {
+    SourceLocation where = loc(n);
+    const YAML::Mark m = n.Mark();
+    const std::string& v = n.Scalar();
+    if (m.pos < 0 || where.line == 0 || v.find('\n') != std::string::npos) return where;
+    const std::size_t pos = static_cast<std::size_t>(m.pos);
+    if (pos >= text_.size()) return where;
+    const char quote = text_[pos];
+    const std::size_t shift = (quote == '\'' || quote == '"') ? 1 : 0;
+    if (pos + 2 * shift + v.size() > text_.size()) return where;
+    if (text_.compare(pos + shift, v.size(), v) != 0) return where;  // escapes or folded lines
+    if (shift && text_[pos + shift + v.size()] != quote) return where;
+    where.column += static_cast<int>(shift + offset);
+    return where;
+  }
+
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& message) const {
+    throw ModelError(loc(n), message);
+  }
+
+  // A map with only `allowed` keys, each at most once.
+  Fields fields(const YAML::Node& n, const std::string& what,
+                const std::vector<std::string>& allowed) const {
+    if (!n.IsMap()) fail(n, "expected a map for " + what + ", got " + describe(n));
+    Fields out;
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      const YAML::Node key = it->first;
+      if (!key.IsScalar()) fail(key, "expected a name as a key in " + what);
+      const std::string& k = key.Scalar();
+      if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
+        std::string hint = suggestion(k, allowed);
+        if (hint.empty()) hint = " (allowed: " + join(allowed) + ")";
+        fail(key, "unknown key '" + k + "' in " + what + hint);
+      }
+      auto found = out.find(k);
+      if (found != out.end())
+        fail(key, "duplicate key '" + k + "' in " + what + " (first at " +
+                      loc(found->second.key).str() + ")");
+      out.emplace(k, Entry{key, it->second});
+    }
+    return out;
+  }
+
+  const Entry* find(const Fields& f, const std::string& key) const {
+    auto it = f.find(key);
+    return it == f.end() ? nullptr : &it->second;
+  }
+
+  const Entry& require(const Fields& f, const std::string& key, const YAML::Node& map,
+                       const std::string& what) const {
+    auto it = f.find(key);
+    if (it == f.end()) fail(map, what + " needs the key '" + key + "'");
+    return it->second;
+  }
+
+  // The value of an entry, which may not be empty.
+  const YAML::Node& value(const Entry& e) const {
+    if (e.value.IsNull()) fail(e.key, "'" + e.key.Scalar() + "' has no value");
+    return e.value;
+  }
+
+  std::string scalar(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsScalar()) fail(n, "expected " + what + ", got " + describe(n));
+    return n.Scalar();
+  }
+
+  std::string name(const Entry& e, const std::string& what) const {
+    const YAML::Node& n = value(e);
+    const std::string s = scalar(n, what);
+    if (s.empty()) fail(n, what + " may not be empty");
+    return s;
+  }
+
+  // A list (an absent or empty value is an empty list).
+  std::vector<YAML::Node> list(const Entry* e, const std::string& what) const {
+    std::vector<YAML::Node> out;
+    if (!e || e->value.IsNull()) return out;
+    if (!e->value.IsSequence()) fail(e->value, "expected a list for " + what + ", got " +
+                                                   describe(e->value));
+    for (auto it = e->value.begin(); it != e->value.end(); ++it) out.push_back(*it);
+    return out;
+  }
+
+  GiNaC::ex expr(const YAML::Node& n, const std::string& what, Scope scope) const {
+    if (!n.IsScalar()) fail(n, "expected an expression for " + what + ", got " + describe(n));
+    auto check = [&](const Token& tok) {
+      auto it = kinds_.find(tok.text);
+      if (it != kinds_.end() && !in_scope(it->second, scope))
+        throw ExpressionError(tok.pos, what + " " + scope_phrase(scope) + "; '" + tok.text +
+                                           "' is " + kind_name(it->second));
+    };
+    try {
+      return parse_checked(*model_, n.Scalar(), check);
+    } catch (const ExpressionError& e) {
+      throw ModelError(loc_in_scalar(n, e.offset()), e.what());
+    }
+  }
+
+  GiNaC::ex expr(const Entry& e, const std::string& what, Scope scope) const {
+    return expr(value(e), what, scope);
+  }
+
+  Vec3 vec3(const YAML::Node& n, const std::string& what, Scope scope) const {
+    if (!n.IsSequence())
+      fail(n, "expected a list of 3 expressions for " + what + ", got " + describe(n));
+    if (n.size() != 3)
+      fail(n, what + " needs 3 components, got " + std::to_string(n.size()));
+    Vec3 v;
+    for (std::size_t i = 0; i < 3; ++i) v[i] = expr(n[i], what, scope);
+    return v;
+  }
+
+  Vec3 vec3(const Entry& e, const std::string& what, Scope scope) const {
+    return vec3(value(e), what, scope);
+  }
+
+  Mat3 mat3(const YAML::Node& n, const std::string& what, Scope scope) const {
+    if (!n.IsSequence())
+      fail(n, "expected a 3x3 matrix (a list of 3 rows) for " + what + ", got " + describe(n));
+    if (n.size() != 3)
+      fail(n, what + " needs 3 rows, got " + std::to_string(n.size()));
+    Mat3 m;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const YAML::Node row = n[i];
+      if (!row.IsSequence())
+        fail(row, "row " + std::to_string(i + 1) + " of " + what +
+                      " should be a list of 3 expressions, got " + describe(row));
+      if (row.size() != 3)
+        fail(row, "row " + std::to_string(i + 1) + " of " + what + " needs 3 entries, got " +
+                      std::to_string(row.size()));
+      for (std::size_t j = 0; j < 3; ++j) m[i][j] = expr(row[j], what, scope);
+    }
+    return m;
+  }
+
+  std::vector<ElementaryRotation> rotations(const Entry& e, const std::string& what,
+                                            Scope scope) const {
+    const YAML::Node& n = value(e);
+    if (!n.IsSequence())
+      fail(n, "expected a list of elementary rotations such as [{z: phi}, {x: psi}] for " + what +
+                  ", got " + describe(n));
+    std::vector<ElementaryRotation> out;
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      const YAML::Node step = *it;
+      Fields f = fields(step, "a rotation step", {"x", "y", "z"});
+      if (f.size() != 1)
+        fail(step, "a rotation step has exactly one key x, y or z (one elementary rotation)");
+      const auto& [axis, entry] = *f.begin();
+      ElementaryRotation r;
+      r.axis = axis == "x" ? Axis::x : axis == "y" ? Axis::y : Axis::z;
+      r.angle = expr(entry, "a rotation angle", scope);
+      out.push_back(r);
+    }
+    return out;
+  }
+
+  std::string check_marker(const YAML::Node& n) const {
+    const std::string m = scalar(n, "a marker name");
+    if (!model_->has_marker(m)) {
+      std::vector<std::string> names;
+      for (const auto& mk : model_->markers()) names.push_back(mk.name);
+      fail(n, "unknown marker '" + m + "'" + suggestion(m, names));
+    }
+    return m;
+  }
+
+  std::string check_coordinate(const YAML::Node& n) const {
+    const std::string c = scalar(n, "a coordinate name");
+    if (model_->coordinate_index(c) < 0) {
+      std::vector<std::string> names;
+      for (const auto& co : model_->coordinates()) names.push_back(co.name);
+      fail(n, "unknown coordinate '" + c + "'" + suggestion(c, names));
+    }
+    return c;
+  }
+
+  void read_parameters(const Entry* e);
+  void read_named_list(const Entry* e, const std::string& what, bool coordinates);
+  void read_body(const YAML::Node& n, const std::set<std::string>& later_bodies);
+  void read_marker(const YAML::Node& n, const std::string& body, const YAML::Node* body_node);
+  void read_force(const YAML::Node& n, std::map<std::string, int>& counters);
+  void read_output(const YAML::Node& n);
+  void read_operating_point(const Entry& e);
+  void define(SymbolKind kind, const std::string& name) { kinds_[name] = kind; }
+
+  const std::string& text_;
+  std::string file_;
+  Model* model_ = nullptr;
+  std::map<std::string, SymbolKind> kinds_;
+  std::set<std::string> used_names_;  // bodies, markers, forces, outputs
+};
+
+Model Reader::read() {
+  std::vector<YAML::Node> docs;
+  try {
+    docs = YAML::LoadAll(text_);
+  } catch (const YAML::ParserException& e) {
+    throw ModelError({file_, e.mark.line + 1, e.mark.column + 1}, e.msg);
+  } catch (const YAML::Exception& e) {
+    throw ModelError({file_, e.mark.line + 1, e.mark.column + 1}, e.msg);
+  }
+  if (docs.empty() || docs[0].IsNull())
+    throw ModelError({file_, 1, 1}, "the model file is empty (expected a map starting with "
+                                    "'model: NAME')");
+  if (docs.size() > 1) fail(docs[1], "a model file holds one YAML document");
+  const YAML::Node root = docs[0];
+  const Fields top = fields(root, "the model file",
+                            {"model", "parameters", "coordinates", "inputs", "bodies", "markers",
+                             "forces", "outputs", "operating_point"});
+
+  const Entry& name_entry = require(top, "model", root, "the model file");
+  const std::string model_name = name(name_entry, "the model name");
+  if (!is_identifier(model_name))
+    fail(name_entry.value, "the model name '" + model_name +
+                               "' must be an identifier (letters, digits and _)");
+  Model model(model_name);
+  model_ = &model;
+
+  read_parameters(find(top, "parameters"));
+  const Entry& coords = require(top, "coordinates", root, "the model file");
+  read_named_list(&coords, "coordinates", true);
+  if (model.coordinates().empty()) fail(coords.key, "a model needs at least one coordinate");
+  read_named_list(find(top, "inputs"), "inputs", false);
+
+  // Names of elements, for default force names and helpful messages.
+  const std::vector<YAML::Node> bodies = list(find(top, "bodies"), "bodies");
+  std::set<std::string> body_names;
+  for (const auto& b : bodies)
+    if (b.IsMap() && b["name"] && b["name"].IsScalar()) body_names.insert(b["name"].Scalar());
+  for (const auto& b : bodies) read_body(b, body_names);
+
+  for (const auto& m : list(find(top, "markers"), "markers")) read_marker(m, "", nullptr);
+
+  const std::vector<YAML::Node> forces = list(find(top, "forces"), "forces");
+  const std::vector<YAML::Node> outputs = list(find(top, "outputs"), "outputs");
+  for (const auto* group : {&forces, &outputs})
+    for (const auto& n : *group)
+      if (n.IsMap() && n["name"] && n["name"].IsScalar()) used_names_.insert(n["name"].Scalar());
+  std::map<std::string, int> counters;
+  for (const auto& f : forces) read_force(f, counters);
+  for (const auto& o : outputs) read_output(o);
+
+  if (const Entry* op = find(top, "operating_point")) read_operating_point(*op);
+
+  try {
+    model.validate();
+  } catch (const ModelError& e) {
+    if (!e.where().file.empty()) throw;
+    throw ModelError(loc(root), e.message());
+  }
+  model_ = nullptr;
+  return model;
+}
+
+void Reader::read_parameters(const Entry* e) {
+  if (!e || e->value.IsNull()) return;
+  const YAML::Node& n = e->value;
+  if (!n.IsMap())
+    fail(n, "expected a map 'name: value' (or 'name: {value, unit, source}') for parameters, got " +
+                describe(n));
+  for (auto it = n.begin(); it != n.end(); ++it) {
+    const YAML::Node key = it->first;
+    const YAML::Node val = it->second;
+    const std::string pname = scalar(key, "a parameter name");
+    YAML::Node value_node = val;
+    std::string unit, source;
+    if (val.IsMap()) {
+      const Fields f = fields(val, "parameter '" + pname + "'", {"value", "unit", "source"});
+      value_node = value(require(f, "value", val, "parameter '" + pname + "'"));
+      if (const Entry* u = find(f, "unit")) unit = scalar(value(*u), "a unit");
+      if (const Entry* s = find(f, "source")) source = scalar(value(*s), "a source");
+    } else if (val.IsNull()) {
+      fail(key, "parameter '" + pname + "' has no value");
+    }
+    const GiNaC::ex v = GiNaC::evalf(expr(value_node, "a parameter value", Scope::constants));
+    if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real())
+      fail(value_node, "parameter '" + pname + "' must have a real value");
+    model_->add_parameter(pname, GiNaC::ex_to<GiNaC::numeric>(v).to_double(), unit, source,
+                          loc(key));
+    define(SymbolKind::parameter, pname);
+  }
+}
+
+void Reader::read_named_list(const Entry* e, const std::string& what, bool coordinates) {
+  for (const auto& n : list(e, what)) {
+    std::string item_name, unit;
+    if (n.IsMap()) {
+      const Fields f = fields(n, "an entry of " + what, {"name", "unit"});
+      item_name = name(require(f, "name", n, "an entry of " + what), "a name");
+      if (const Entry* u = find(f, "unit")) unit = scalar(value(*u), "a unit");
+    } else {
+      item_name = scalar(n, "a name or {name, unit} in " + what);
+    }
+    if (coordinates) {
+      model_->add_coordinate(item_name, unit, loc(n));
+      define(SymbolKind::coordinate, item_name);
+      define(SymbolKind::rate, item_name + "_dot");
+    } else {
+      model_->add_input(item_name, unit, loc(n));
+      define(SymbolKind::input, item_name);
+    }
+  }
+}
+
+void Reader::read_body(const YAML::Node& n, const std::set<std::string>& all_bodies) {
+  const Fields f = fields(n, "a body",
+                          {"name", "parent", "translation", "rotation", "rotation_matrix", "mass",
+                           "com", "inertia", "markers"});
+  Body b;
+  b.name = name(require(f, "name", n, "a body"), "a body name");
+  b.where = loc(n);
+  const std::string what = "body '" + b.name + "'";
+  if (const Entry* p = find(f, "parent")) {
+    const YAML::Node& pn = value(*p);
+    b.parent = scalar(pn, "a body name");
+    if (b.parent != kWorld) {
+      bool defined = true;
+      try {
+        model_->body_index(b.parent);
+      } catch (const std::out_of_range&) {
+        defined = false;
+      }
+      if (!defined) {
+        if (b.parent == b.name) fail(pn, what + " cannot be its own parent");
+        if (all_bodies.count(b.parent))
+          fail(pn, "parent '" + b.parent + "' of " + what +
+                       " must be defined before it (bodies are listed parents first)");
+        std::vector<std::string> names(all_bodies.begin(), all_bodies.end());
+        names.push_back(kWorld);
+        fail(pn, "unknown parent body '" + b.parent + "'" + suggestion(b.parent, names));
+      }
+    }
+  }
+  if (const Entry* t = find(f, "translation")) b.translation = vec3(*t, "a translation", Scope::positions);
+  const Entry* rot = find(f, "rotation");
+  const Entry* rot_m = find(f, "rotation_matrix");
+  if (rot && rot_m) fail(rot_m->key, what + ": give either 'rotation' or 'rotation_matrix', not both");
+  if (rot) b.rotations = rotations(*rot, "a rotation", Scope::positions);
+  if (rot_m) b.rotation_matrix = mat3(value(*rot_m), "a rotation matrix", Scope::positions);
+  if (const Entry* m = find(f, "mass")) b.mass = expr(*m, "a mass", Scope::parameters);
+  if (const Entry* c = find(f, "com")) b.com = vec3(*c, "a centre of mass", Scope::parameters);
+  if (const Entry* i = find(f, "inertia")) {
+    const YAML::Node& in = value(*i);
+    if (in.IsMap()) {
+      const Fields g = fields(in, "an inertia tensor", {"xx", "yy", "zz", "xy", "xz", "yz"});
+      static const std::map<std::string, std::pair<int, int>> index = {
+          {"xx", {0, 0}}, {"yy", {1, 1}}, {"zz", {2, 2}},
+          {"xy", {0, 1}}, {"xz", {0, 2}}, {"yz", {1, 2}}};
+      for (const auto& [key, entry] : g) {
+        const auto [r, c] = index.at(key);
+        const GiNaC::ex x = expr(entry, "an inertia tensor", Scope::parameters);
+        b.inertia[r][c] = x;
+        b.inertia[c][r] = x;
+      }
+    } else {
+      b.inertia = mat3(in, "an inertia tensor", Scope::parameters);
+      for (int r = 0; r < 3; ++r)
+        for (int c = r + 1; c < 3; ++c)
+          if (!(b.inertia[r][c] - b.inertia[c][r]).is_zero())
+            fail(in, "the inertia tensor of " + what + " is not symmetric (entries " +
+                         std::to_string(r + 1) + "," + std::to_string(c + 1) + " and " +
+                         std::to_string(c + 1) + "," + std::to_string(r + 1) + ")");
+    }
+  }
+  used_names_.insert(b.name);
+  model_->add_body(b);
+  if (const Entry* ms = find(f, "markers"))
+    for (const auto& m : list(ms, "the markers of " + what)) read_marker(m, b.name, &n);
+}
+
+void Reader::read_marker(const YAML::Node& n, const std::string& body, const YAML::Node* on_body) {
+  std::vector<std::string> keys = {"name", "position", "rotation", "rotation_matrix"};
+  if (!on_body) keys.push_back("body");
+  const Fields f = fields(n, "a marker", keys);
+  Marker m;
+  m.name = name(require(f, "name", n, "a marker"), "a marker name");
+  m.where = loc(n);
+  m.body = on_body ? body : std::string(kWorld);
+  if (const Entry* b = find(f, "body")) {
+    const YAML::Node& bn = value(*b);
+    m.body = scalar(bn, "a body name");
+    if (m.body != kWorld) {
+      std::vector<std::string> names = {kWorld};
+      for (const auto& bd : model_->bodies()) names.push_back(bd.name);
+      if (std::find(names.begin(), names.end(), m.body) == names.end())
+        fail(bn, "unknown body '" + m.body + "'" + suggestion(m.body, names));
+    }
+  }
+  if (const Entry* p = find(f, "position")) m.position = vec3(*p, "a marker position", Scope::parameters);
+  const Entry* rot = find(f, "rotation");
+  const Entry* rot_m = find(f, "rotation_matrix");
+  if (rot && rot_m)
+    fail(rot_m->key, "marker '" + m.name + "': give either 'rotation' or 'rotation_matrix', not both");
+  if (rot)
+    for (const auto& r : rotations(*rot, "a marker rotation", Scope::parameters))
+      m.rotation = multiply(m.rotation, rotation_matrix(r));
+  if (rot_m) m.rotation = mat3(value(*rot_m), "a marker rotation matrix", Scope::parameters);
+  used_names_.insert(m.name);
+  model_->add_marker(m);
+}
+
+void Reader::read_force(const YAML::Node& n, std::map<std::string, int>& counters) {
+  static const std::vector<std::string> types = {"gravity", "spring",      "damper",
+                                                 "bushing", "generalized", "applied"};
+  if (!n.IsMap()) fail(n, "expected a map for a force, got " + describe(n));
+  const YAML::Node type_node = n["type"];
+  if (!type_node) fail(n, "a force needs the key 'type' (one of: " + join(types) + ")");
+  const std::string type = scalar(type_node, "a force type");
+  if (std::find(types.begin(), types.end(), type) == types.end())
+    fail(type_node, "unknown force type '" + type + "'" +
+                        [&] {
+                          std::string s = suggestion(type, types);
+                          return s.empty() ? " (one of: " + join(types) + ")" : s;
+                        }());
+  std::vector<std::string> keys = {"type", "name"};
+  if (type == "gravity") keys.insert(keys.end(), {"g"});
+  if (type == "spring") keys.insert(keys.end(), {"between", "stiffness", "rest_length"});
+  if (type == "damper") keys.insert(keys.end(), {"between", "damping"});
+  if (type == "bushing") keys.insert(keys.end(), {"between", "stiffness", "damping"});
+  if (type == "generalized") keys.insert(keys.end(), {"coordinate", "value"});
+  if (type == "applied") keys.insert(keys.end(), {"marker", "frame", "force", "torque"});
+  const std::string what = "a " + type + " force";
+  const Fields f = fields(n, what, keys);
+
+  std::string force_name;
+  if (const Entry* e = find(f, "name")) {
+    force_name = name(*e, "a force name");
+  } else {
+    int& k = counters[type];
+    do force_name = type + std::to_string(++k);
+    while (used_names_.count(force_name));
+  }
+  used_names_.insert(force_name);
+  const SourceLocation where = loc(n);
+
+  std::string marker_a, marker_b;
+  if (const Entry* e = find(f, "between")) {
+    const YAML::Node& bn = value(*e);
+    if (!bn.IsSequence() || bn.size() != 2)
+      fail(bn, "'between' needs a list of two marker names [A, B], got " +
+                   (bn.IsSequence() ? std::to_string(bn.size()) + " entries" : describe(bn)));
+    marker_a = check_marker(bn[0]);
+    marker_b = check_marker(bn[1]);
+    if (marker_a == marker_b) fail(bn[1], "a " + type + " between marker '" + marker_a + "' and itself");
+  } else if (type == "spring" || type == "damper" || type == "bushing") {
+    require(f, "between", n, what);
+  }
+
+  if (type == "gravity") {
+    Gravity g;
+    g.name = force_name;
+    g.g = vec3(require(f, "g", n, what), "gravity", Scope::parameters);
+    g.where = where;
+    model_->add_gravity(g);
+  } else if (type == "spring") {
+    Spring s;
+    s.name = force_name;
+    s.marker_a = marker_a;
+    s.marker_b = marker_b;
+    s.stiffness = expr(require(f, "stiffness", n, what), "a spring stiffness", Scope::parameters);
+    if (const Entry* e = find(f, "rest_length"))
+      s.rest_length = expr(*e, "a rest length", Scope::parameters);
+    s.where = where;
+    model_->add_spring(s);
+  } else if (type == "damper") {
+    Damper d;
+    d.name = force_name;
+    d.marker_a = marker_a;
+    d.marker_b = marker_b;
+    d.damping = expr(require(f, "damping", n, what), "a damping coefficient", Scope::parameters);
+    d.where = where;
+    model_->add_damper(d);
+  } else if (type == "bushing") {
+    Bushing b;
+    b.name = force_name;
+    b.marker_a = marker_a;
+    b.marker_b = marker_b;
+    auto pair = [&](const char* key, Vec3& translation, Vec3& rotation) {
+      const Entry* e = find(f, key);
+      if (!e) return;
+      const YAML::Node& pn = value(*e);
+      const Fields g = fields(pn, std::string("the ") + key + " of a bushing", {"translation", "rotation"});
+      if (const Entry* t = find(g, "translation"))
+        translation = vec3(*t, std::string("a bushing ") + key, Scope::parameters);
+      if (const Entry* r = find(g, "rotation"))
+        rotation = vec3(*r, std::string("a bushing ") + key, Scope::parameters);
+    };
+    pair("stiffness", b.k_translation, b.k_rotation);
+    pair("damping", b.d_translation, b.d_rotation);
+    b.where = where;
+    model_->add_bushing(b);
+  } else if (type == "generalized") {
+    GeneralizedForce g;
+    g.name = force_name;
+    g.coordinate = check_coordinate(value(require(f, "coordinate", n, what)));
+    g.value = expr(require(f, "value", n, what), "a generalized force", Scope::any);
+    g.where = where;
+    model_->add_generalized_force(g);
+  } else {  // applied
+    AppliedForce a;
+    a.name = force_name;
+    a.marker = check_marker(value(require(f, "marker", n, what)));
+    if (const Entry* e = find(f, "frame")) {
+      const YAML::Node& fn = value(*e);
+      const std::string frame = scalar(fn, "a frame (world or marker)");
+      if (frame == "world") a.frame = ForceFrame::world;
+      else if (frame == "marker") a.frame = ForceFrame::marker;
+      else fail(fn, "unknown frame '" + frame + "' (world or marker)");
+    }
+    if (!find(f, "force") && !find(f, "torque"))
+      fail(n, "an applied force needs 'force', 'torque' or both");
+    if (const Entry* e = find(f, "force")) a.force = vec3(*e, "a force", Scope::any);
+    if (const Entry* e = find(f, "torque")) a.torque = vec3(*e, "a torque", Scope::any);
+    a.where = where;
+    model_->add_applied_force(a);
+  }
+}
+
+void Reader::read_output(const YAML::Node& n) {
+  static const std::vector<std::string> types = {"position", "velocity", "coordinate", "rate",
+                                                 "expression"};
+  if (!n.IsMap()) fail(n, "expected a map for an output, got " + describe(n));
+  const YAML::Node type_node = n["type"];
+  if (!type_node) fail(n, "an output needs the key 'type' (one of: " + join(types) + ")");
+  const std::string type = scalar(type_node, "an output type");
+  if (std::find(types.begin(), types.end(), type) == types.end()) {
+    std::string hint = suggestion(type, types);
+    if (hint.empty()) hint = " (one of: " + join(types) + ")";
+    fail(type_node, "unknown output type '" + type + "'" + hint);
+  }
+  std::vector<std::string> keys = {"name", "type", "unit"};
+  if (type == "position" || type == "velocity") keys.insert(keys.end(), {"marker", "direction"});
+  if (type == "coordinate" || type == "rate") keys.insert(keys.end(), {"coordinate"});
+  if (type == "expression") keys.insert(keys.end(), {"expression"});
+  const std::string what = "a " + type + " output";
+  const Fields f = fields(n, what, keys);
+  Output o;
+  o.name = name(require(f, "name", n, what), "an output name");
+  o.where = loc(n);
+  if (const Entry* u = find(f, "unit")) o.unit = scalar(value(*u), "a unit");
+  if (type == "position" || type == "velocity") {
+    o.kind = type == "position" ? OutputKind::position : OutputKind::velocity;
+    o.marker = check_marker(value(require(f, "marker", n, what)));
+    o.direction = vec3(require(f, "direction", n, what), "an output direction", Scope::parameters);
+  } else if (type == "coordinate" || type == "rate") {
+    o.kind = type == "coordinate" ? OutputKind::coordinate : OutputKind::rate;
+    o.coordinate = check_coordinate(value(require(f, "coordinate", n, what)));
+  } else {
+    o.kind = OutputKind::expression;
+    o.expression = expr(require(f, "expression", n, what), "an output expression", Scope::no_inputs);
+  }
+  model_->add_output(o);
+}
+
+void Reader::read_operating_point(const Entry& e) {
+  const YAML::Node& n = value(e);
+  const Fields f = fields(n, "the operating point", {"type", "position", "velocity"});
+  OperatingPoint op;
+  op.where = loc(n);
+  if (const Entry* t = find(f, "type")) {
+    const YAML::Node& tn = value(*t);
+    const std::string type = scalar(tn, "an operating point type (given or equilibrium)");
+    if (type == "given") op.kind = OperatingPoint::Kind::given;
+    else if (type == "equilibrium") op.kind = OperatingPoint::Kind::equilibrium;
+    else fail(tn, "unknown operating point type '" + type + "' (given or equilibrium)");
+  }
+  auto values = [&](const char* key, std::map<std::string, GiNaC::ex>& out) {
+    const Entry* v = find(f, key);
+    if (!v || v->value.IsNull()) return;
+    const YAML::Node& vn = v->value;
+    if (!vn.IsMap())
+      fail(vn, std::string("expected a map 'coordinate: value' for the operating point's ") + key +
+                   ", got " + describe(vn));
+    std::set<std::string> seen;
+    for (auto it = vn.begin(); it != vn.end(); ++it) {
+      const std::string c = check_coordinate(it->first);
+      if (!seen.insert(c).second) fail(it->first, "coordinate '" + c + "' is given twice");
+      if (it->second.IsNull()) fail(it->first, "coordinate '" + c + "' has no value");
+      out[c] = expr(it->second, "an operating point value", Scope::parameters);
+    }
+  };
+  values("position", op.position);
+  values("velocity", op.velocity);
+  model_->set_operating_point(op);
+}
+
+}  // namespace
+
+namespace detail {
+
+GiNaC::ex parse_expression(const Model& model, const std::string& text) {
+  return parse_checked(model, text, nullptr);
+}
+
+}  // namespace detail
+
+Model read_model_string(const std::string& text, const std::string& file_name) {
+  return Reader(text, file_name).read();
+}
+
+Model read_model_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ModelError({path, 0, 0}, "cannot open the model file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ModelError({path, 0, 0}, "cannot read the model file");
+  return read_model_string(text.str(), path);
+}
+
+}  // namespace mbsgen
