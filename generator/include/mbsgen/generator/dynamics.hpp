@@ -1,0 +1,36 @@
+// Stage 2: the minimal equations of motion M(y) ÿ + k(y, ẏ) = q(y, ẏ, u) (seed eqs. 3.2–3.6
+// projected with J̄ᵀ, DESIGN.md §2), and the outputs z(y, ẏ).
+//
+// Newton–Euler per body about the world origin, f_i = I_i a_i + V_i ×* I_i V_i, is projected
+// with the joint columns φ of kinematics.hpp through composite sums over subtrees, so that
+//   M_jk = φ_jᵀ (I^c φ_k)         (composite-rigid-body form of J̄ᵀ M̄ J̄),
+//   (k − q)_j = φ_jᵀ F^c          (F^c the subtree sum of inertial minus applied wrenches).
+// Springs, dampers and bushings enter through their potential V(y) and dissipation function
+// R(y, ẏ): q_j = −∂V/∂y_j − ∂R/∂ẏ_j, which equals J̄ᵀ q̄ of their forces and keeps the
+// stiffness matrix of a conservative element exactly symmetric.
+#pragma once
+
+#include "mbsgen/generator/kinematics.hpp"
+
+#include <vector>
+
+namespace mbsgen {
+
+using ExMatrix = std::vector<std::vector<GiNaC::ex>>;
+
+/// The derived equations; every expression refers to intermediates of `program`.
+struct Equations {
+  const Model* model = nullptr;
+  Program program;
+  Kinematics kinematics;
+  std::vector<GiNaC::symbol> y, yd, u, p;  ///< coordinates, rates, inputs, parameters
+  ExMatrix M;                               ///< f×f mass matrix M(y)
+  std::vector<GiNaC::ex> residual;          ///< k(y, ẏ) − q(y, ẏ, u), length f
+  std::vector<GiNaC::ex> outputs;           ///< z(y, ẏ), one per model output
+  ExMatrix JT, JR;                          ///< per body 3×f: centre-of-mass and angular Jacobians
+};
+
+/// Derives the equations of a validated model.
+Equations derive(const Model& model);
+
+}  // namespace mbsgen

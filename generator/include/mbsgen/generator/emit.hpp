@@ -1,0 +1,47 @@
+// Stage 4: emission of plain C++17 kernels and a JSON manifest.
+//
+// Kernels are `extern "C"` functions `<id>_<kernel>(inputs…, outputs…)` that write into caller
+// buffers (matrices column-major), never allocate or throw, and return 0, or 1 when a result is
+// not finite. ABI version kAbiVersion; see docs/generated-abi.md.
+#pragma once
+
+#include "mbsgen/generator/linearize.hpp"
+
+#include <string>
+#include <vector>
+
+namespace mbsgen {
+
+inline constexpr int kAbiVersion = 1;
+inline constexpr const char* kGeneratorVersion = "0.1.0";
+
+struct EmitOptions {
+  bool cse = true;
+  std::string scene = "full";
+  std::string source_file;  ///< shown in the header; the model file as given
+};
+
+struct KernelInfo {
+  std::string name;
+  std::string signature;
+  std::size_t operations = 0;  ///< +, −, ×, ÷ and function calls in the emitted code
+};
+
+struct GeneratedCode {
+  std::string id;  ///< C identifier prefix of the kernels
+  std::string header, source, manifest;
+  std::vector<KernelInfo> kernels;
+};
+
+GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin,
+                   const EmitOptions& options = {});
+
+/// Writes `<id>.hpp`, `<id>.cpp`, `<id>.json` into dir (created if missing), each atomically
+/// (a temporary file, then rename). Files whose content is unchanged are not touched, so a
+/// build system does not recompile them.
+void write_generated(const GeneratedCode& code, const std::string& dir);
+
+/// A C identifier made from a model name.
+std::string identifier(const std::string& name);
+
+}  // namespace mbsgen

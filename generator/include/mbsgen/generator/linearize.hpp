@@ -1,0 +1,24 @@
+// Stage 3: linearization about an operating point (seed eqs. 3.7–3.8, DESIGN.md §2):
+//   M y_s'' + Q y_s' + K y_s = B u,   z_s = C_y y_s + C_v y_s',
+//   M = M(y0), Q = ∂(k − q)/∂ẏ, K = ∂(k − q)/∂y, B = −∂(k − q)/∂u at (y0, ẏ0, u = 0),
+// symbolic in the parameters and in (y0, ẏ0), which stay run-time arguments. Q splits into
+// damping D = sym Q and gyroscopic G = skew Q, K into stiffness sym K and circulatory N = skew K.
+#pragma once
+
+#include "mbsgen/generator/dynamics.hpp"
+
+namespace mbsgen {
+
+struct LinearEquations {
+  /// True when every steady velocity of the operating point is zero: ẏ0 = 0 is then
+  /// substituted before differentiation and the kernels take no ẏ0.
+  bool at_rest = true;
+  ExMatrix M, Q, K, B, Cy, Cv;  ///< f×f, f×f, f×f, f×m, r×f, r×f (expressions in y, ẏ, p)
+  ExMatrix D, G, Ks, N;         ///< sym Q, skew Q, sym K, skew K
+  std::vector<GiNaC::ex> y0, yd0;  ///< default operating point (expressions in p)
+  bool equilibrium = false;     ///< y0 is an initial guess for a static equilibrium
+};
+
+LinearEquations linearize(Equations& eq);
+
+}  // namespace mbsgen

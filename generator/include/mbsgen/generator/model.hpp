@@ -1,0 +1,273 @@
+// The multibody model as the generator sees it: parameters, generalized coordinates, a tree of
+// bodies with markers, force elements, inputs, outputs and an operating point. Every quantity is
+// a GiNaC expression in the model's symbols. The YAML reader (yaml_reader.hpp) is one client of
+// this API; tests and benchmarks build models with it directly.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <array>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace mbsgen {
+
+/// Where something was written in a model file (1-based line and column; 0 when unknown).
+struct SourceLocation {
+  std::string file;
+  int line = 0;
+  int column = 0;
+  /// "FILE:LINE:COL" (or what of it is known).
+  std::string str() const;
+};
+
+/// A bad model: the message reads `FILE:LINE:COL: error: what` in the style of a compiler.
+class ModelError : public std::runtime_error {
+ public:
+  ModelError(const SourceLocation& where, const std::string& what);
+  const SourceLocation& where() const { return where_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  SourceLocation where_;
+  std::string message_;
+};
+
+using Vec3 = std::array<GiNaC::ex, 3>;
+using Mat3 = std::array<std::array<GiNaC::ex, 3>, 3>;
+
+Vec3 zero_vec3();
+Mat3 identity_mat3();
+Mat3 zero_mat3();
+
+/// The name of the inertial frame; usable as a parent body and as the body of a marker.
+inline const char* const kWorld = "world";
+
+enum class Axis { x, y, z };
+
+/// Rotation by `angle` [rad] about a coordinate axis of the frame it is applied in.
+struct ElementaryRotation {
+  Axis axis = Axis::z;
+  GiNaC::ex angle;
+};
+
+/// A point and a frame fixed on a body. position [m] and rotation (marker frame to body frame)
+/// are expressed in the body frame.
+struct Marker {
+  std::string name;
+  std::string body;  ///< owning body, or kWorld
+  Vec3 position = zero_vec3();
+  Mat3 rotation = identity_mat3();
+  SourceLocation where;
+};
+
+/// A rigid body. Its frame is placed relative to the parent frame by `translation` [m] (in the
+/// parent frame) and by the rotation R = R_1 R_2 … R_n of `rotations` (or by `rotation_matrix`
+/// when given), so that r_i = r_p + S_p t_i and S_i = S_p R_i (seed eq. 3.3).
+struct Body {
+  std::string name;
+  std::string parent = kWorld;
+  Vec3 translation = zero_vec3();
+  std::vector<ElementaryRotation> rotations;
+  std::optional<Mat3> rotation_matrix;
+  GiNaC::ex mass = 0;              ///< [kg]
+  Vec3 com = zero_vec3();          ///< centre of mass in the body frame [m]
+  Mat3 inertia = zero_mat3();      ///< inertia tensor about the centre of mass, body frame [kg m²]
+  SourceLocation where;
+};
+
+/// Uniform gravitational acceleration [m/s²] in the world frame.
+struct Gravity {
+  std::string name = "gravity";
+  Vec3 g = zero_vec3();
+  SourceLocation where;
+};
+
+/// Linear point-to-point spring between two markers: potential ½ k (L − L0)².
+struct Spring {
+  std::string name;
+  std::string marker_a, marker_b;
+  GiNaC::ex stiffness;        ///< k [N/m]
+  GiNaC::ex rest_length = 0;  ///< L0 [m]
+  SourceLocation where;
+};
+
+/// Linear point-to-point damper between two markers: dissipation function ½ c L̇².
+struct Damper {
+  std::string name;
+  std::string marker_a, marker_b;
+  GiNaC::ex damping;  ///< c [N s/m]
+  SourceLocation where;
+};
+
+/// Six-component linear bushing (a ligament or a compliant joint) between two markers. With
+/// Δr = S_aᵀ (r_b − r_a) and the small relative rotation θ = vee(skew(S_aᵀ S_b)) both in the
+/// frame of marker a: V = ½ Δrᵀ diag(k_t) Δr + ½ θᵀ diag(k_r) θ and
+/// R = ½ Δṙᵀ diag(d_t) Δṙ + ½ ω_relᵀ diag(d_r) ω_rel.
+struct Bushing {
+  std::string name;
+  std::string marker_a, marker_b;
+  Vec3 k_translation = zero_vec3();  ///< [N/m]
+  Vec3 k_rotation = zero_vec3();     ///< [N m/rad]
+  Vec3 d_translation = zero_vec3();  ///< [N s/m]
+  Vec3 d_rotation = zero_vec3();     ///< [N m s/rad]
+  SourceLocation where;
+};
+
+/// A generalized force on one coordinate (may depend on coordinates, rates and inputs).
+struct GeneralizedForce {
+  std::string name;
+  std::string coordinate;
+  GiNaC::ex value;
+  SourceLocation where;
+};
+
+enum class ForceFrame { world, marker };
+
+/// A force [N] at a marker's point and a torque [N m], resolved in the world frame or in the
+/// marker's frame.
+struct AppliedForce {
+  std::string name;
+  std::string marker;
+  ForceFrame frame = ForceFrame::world;
+  Vec3 force = zero_vec3();
+  Vec3 torque = zero_vec3();
+  SourceLocation where;
+};
+
+/// A named excitation amplitude; its symbol may appear (linearly) in force expressions.
+struct Input {
+  std::string name;
+  std::string unit;
+  SourceLocation where;
+};
+
+enum class OutputKind { position, velocity, coordinate, rate, expression };
+
+/// A measured quantity z(y, ẏ); its linearization gives a row of C_y and C_v.
+struct Output {
+  std::string name;
+  OutputKind kind = OutputKind::coordinate;
+  std::string marker;               ///< position, velocity
+  Vec3 direction = zero_vec3();     ///< world frame, position and velocity
+  std::string coordinate;           ///< coordinate, rate
+  GiNaC::ex expression;             ///< expression
+  std::string unit;
+  SourceLocation where;
+};
+
+/// Where the model is linearized: given values, or a static equilibrium found from a guess;
+/// steady velocities (zero unless given) allow steady motions such as a spinning rotor.
+struct OperatingPoint {
+  enum class Kind { given, equilibrium };
+  Kind kind = Kind::given;
+  std::map<std::string, GiNaC::ex> position;  ///< coordinate name → value (or initial guess)
+  std::map<std::string, GiNaC::ex> velocity;  ///< coordinate name → steady rate
+  SourceLocation where;
+};
+
+struct Parameter {
+  std::string name;
+  double value = 0;  ///< SI default
+  std::string unit;
+  std::string source;
+  GiNaC::symbol symbol;
+  SourceLocation where;
+};
+
+struct Coordinate {
+  std::string name;
+  std::string unit;
+  GiNaC::symbol position;  ///< y_k
+  GiNaC::symbol velocity;  ///< ẏ_k, written `NAME_dot` in expressions
+  SourceLocation where;
+};
+
+/// A multibody model. Add parameters, coordinates and inputs first (they create the symbols that
+/// expressions use), then bodies, markers, forces and outputs. `validate()` checks the whole.
+class Model {
+ public:
+  explicit Model(std::string name);
+
+  const std::string& name() const { return name_; }
+
+  const GiNaC::symbol& add_parameter(const std::string& name, double value,
+                                     const std::string& unit = "", const std::string& source = "",
+                                     const SourceLocation& where = {});
+  const Coordinate& add_coordinate(const std::string& name, const std::string& unit = "",
+                                   const SourceLocation& where = {});
+  const GiNaC::symbol& add_input(const std::string& name, const std::string& unit = "",
+                                 const SourceLocation& where = {});
+  void add_body(Body body);
+  void add_marker(Marker marker);
+  void add_gravity(Gravity gravity);
+  void add_spring(Spring spring);
+  void add_damper(Damper damper);
+  void add_bushing(Bushing bushing);
+  void add_generalized_force(GeneralizedForce force);
+  void add_applied_force(AppliedForce force);
+  void add_output(Output output);
+  void set_operating_point(OperatingPoint op) { operating_point_ = std::move(op); }
+
+  /// Symbol of a parameter, coordinate (position), coordinate rate (`NAME_dot`) or input.
+  GiNaC::ex symbol(const std::string& name) const;
+  /// The table every expression of this model is parsed against.
+  const GiNaC::symtab& symbol_table() const { return symtab_; }
+
+  const std::vector<Parameter>& parameters() const { return parameters_; }
+  const std::vector<Coordinate>& coordinates() const { return coordinates_; }
+  const std::vector<Input>& inputs() const { return inputs_; }
+  const std::vector<GiNaC::symbol>& input_symbols() const { return input_symbols_; }
+  const std::vector<Body>& bodies() const { return bodies_; }
+  const std::vector<Marker>& markers() const { return markers_; }
+  const std::vector<Gravity>& gravity() const { return gravity_; }
+  const std::vector<Spring>& springs() const { return springs_; }
+  const std::vector<Damper>& dampers() const { return dampers_; }
+  const std::vector<Bushing>& bushings() const { return bushings_; }
+  const std::vector<GeneralizedForce>& generalized_forces() const { return generalized_forces_; }
+  const std::vector<AppliedForce>& applied_forces() const { return applied_forces_; }
+  const std::vector<Output>& outputs() const { return outputs_; }
+  const OperatingPoint& operating_point() const { return operating_point_; }
+
+  /// Index of a body (kWorld → -1); throws std::out_of_range for unknown names.
+  int body_index(const std::string& name) const;
+  /// Index of a coordinate; -1 when unknown.
+  int coordinate_index(const std::string& name) const;
+  const Marker& marker(const std::string& name) const;
+  bool has_marker(const std::string& name) const;
+
+  /// Checks references (parents, markers, coordinates), the tree (no cycles, every body reaches
+  /// the world), masses and inertias, and that every expression uses only known symbols.
+  /// Throws ModelError at the offending element.
+  void validate() const;
+
+ private:
+  void check_new_symbol(const std::string& name, const SourceLocation& where);
+  void check_new_element(const std::string& name, const char* kind, const SourceLocation& where);
+
+  std::string name_;
+  GiNaC::symtab symtab_;
+  std::vector<Parameter> parameters_;
+  std::vector<Coordinate> coordinates_;
+  std::vector<Input> inputs_;
+  std::vector<GiNaC::symbol> input_symbols_;
+  std::vector<Body> bodies_;
+  std::vector<Marker> markers_;
+  std::vector<Gravity> gravity_;
+  std::vector<Spring> springs_;
+  std::vector<Damper> dampers_;
+  std::vector<Bushing> bushings_;
+  std::vector<GeneralizedForce> generalized_forces_;
+  std::vector<AppliedForce> applied_forces_;
+  std::vector<Output> outputs_;
+  OperatingPoint operating_point_;
+  std::map<std::string, int> body_index_;
+  std::map<std::string, int> marker_index_;
+  std::map<std::string, SourceLocation> symbol_names_;  // parameters, coordinates, rates, inputs
+  std::map<std::string, std::pair<std::string, SourceLocation>> element_names_;  // name → kind
+};
+
+}  // namespace mbsgen

@@ -1,0 +1,82 @@
+// A straight-line program of intermediate quantities t_k = f_k(leaves, t_0 … t_{k-1}).
+//
+// Multibody kinematics nests deeply (S_i = S_p R_i over the whole tree); written out as one
+// expression per entry it swells exponentially. The generator instead names every non-trivial
+// intermediate once (`define`), and differentiates and substitutes *through* those names with
+// memoisation (`diff`, `substitute`): total derivatives are forward-mode automatic
+// differentiation done symbolically, so their cost is linear in the size of the program.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace mbsgen {
+
+class Program {
+ public:
+  struct Definition {
+    GiNaC::symbol symbol;
+    GiNaC::ex value;
+  };
+
+  /// Registers an independent variable (a coordinate, rate, input or parameter). All variables
+  /// must be registered before the first `define`.
+  void add_variable(const GiNaC::symbol& s);
+
+  /// Names `e` as an intermediate and returns its symbol; numbers, symbols and c·symbol are
+  /// returned as they are, and an expression defined before returns its old symbol.
+  GiNaC::ex define(const GiNaC::ex& e);
+
+  /// Total derivative de/dx through the intermediates (x a registered variable).
+  GiNaC::ex diff(const GiNaC::ex& e, const GiNaC::symbol& x);
+
+  /// True when e depends on the variable x, directly or through intermediates.
+  bool depends_on(const GiNaC::ex& e, const GiNaC::symbol& x);
+
+  /// Replaces variables by values throughout the program (constants propagate), memoised per
+  /// `Substitution` object, so a whole kernel can be specialised at once.
+  class Substitution {
+   public:
+    explicit Substitution(GiNaC::exmap values) : values_(std::move(values)) {}
+
+   private:
+    friend class Program;
+    GiNaC::exmap values_;
+    std::vector<std::uint64_t> mask_;
+    std::unordered_map<std::size_t, GiNaC::ex> memo_;
+  };
+  GiNaC::ex substitute(const GiNaC::ex& e, Substitution& s);
+
+  /// e with every intermediate written out (for exact checks on small models only).
+  GiNaC::ex inline_all(const GiNaC::ex& e);
+
+  const std::vector<Definition>& definitions() const { return defs_; }
+  /// Index of an intermediate symbol in definitions(), or -1 for anything else.
+  long index_of(const GiNaC::ex& symbol) const;
+  std::size_t variable_count() const { return variables_.size(); }
+
+ private:
+  using Bits = std::vector<std::uint64_t>;
+  Bits dependencies(const GiNaC::ex& e) const;
+  void collect_intermediates(const GiNaC::ex& e, std::vector<std::size_t>& out) const;
+  GiNaC::ex intern_functions(const GiNaC::ex& e);
+  GiNaC::ex define_node(const GiNaC::ex& e);
+  GiNaC::ex diff_intermediate(std::size_t k, std::size_t variable);
+  GiNaC::ex substitute_intermediate(std::size_t k, Substitution& s);
+  bool bits_intersect(const Bits& a, const Bits& b) const;
+
+  std::vector<GiNaC::symbol> variables_;
+  std::unordered_map<GiNaC::ex, std::size_t, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> variable_index_;
+  std::vector<Definition> defs_;
+  std::vector<Bits> deps_;
+  std::unordered_map<GiNaC::ex, std::size_t, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> def_index_;
+  std::unordered_map<GiNaC::ex, GiNaC::ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> interned_;
+  std::unordered_map<std::uint64_t, GiNaC::ex> diff_memo_;
+  std::unordered_map<std::size_t, GiNaC::ex> inline_memo_;
+};
+
+}  // namespace mbsgen

@@ -1,0 +1,191 @@
+#include "mbsgen/generator/dynamics.hpp"
+
+namespace mbsgen {
+
+using GiNaC::ex;
+
+namespace {
+
+Spatial wrench_at_origin(const Vec3& point, const Vec3& force, const Vec3& torque) {
+  return {add(cross(point, force), torque), force};
+}
+
+}  // namespace
+
+Equations derive(const Model& model) {
+  model.validate();
+  Equations eq;
+  eq.model = &model;
+  for (const auto& c : model.coordinates()) eq.y.push_back(c.position);
+  for (const auto& c : model.coordinates()) eq.yd.push_back(c.velocity);
+  eq.u = model.input_symbols();
+  for (const auto& p : model.parameters()) eq.p.push_back(p.symbol);
+  Program& prog = eq.program;
+  for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p})
+    for (const auto& s : *group) prog.add_variable(s);
+
+  eq.kinematics = compute_kinematics(model, prog);
+  Kinematics& kin = eq.kinematics;
+  const std::size_t f = eq.y.size();
+  const std::size_t nb = kin.bodies.size();
+
+  // Per-body wrench: inertial minus applied, about the world origin.
+  std::vector<Spatial> wrench(nb);
+  for (std::size_t i = 0; i < nb; ++i) {
+    const BodyKinematics& b = kin.bodies[i];
+    Spatial IV = define(prog, apply(b.inertia, b.V));
+    wrench[i] = add(apply(b.inertia, b.bias), cross_force(b.V, IV));
+    for (const auto& g : model.gravity()) {
+      Vec3 force = scale(b.inertia.m, g.g);
+      wrench[i] = add(wrench[i], scale(-1, Spatial{cross(b.inertia.h, g.g), force}));
+    }
+  }
+  for (const auto& a : model.applied_forces()) {
+    int b = model.body_index(model.marker(a.marker).body);
+    if (b < 0) continue;  // a force on the ground does no work
+    Vec3 F = a.force, L = a.torque;
+    if (a.frame == ForceFrame::marker) {
+      Mat3 S = kin.marker_frame(model, prog, a.marker);
+      F = mul(S, F);
+      L = mul(S, L);
+    }
+    Vec3 P = kin.marker_position(model, prog, a.marker);
+    auto& w = wrench[static_cast<std::size_t>(b)];
+    w = add(w, scale(-1, wrench_at_origin(P, F, L)));
+  }
+  for (std::size_t i = 0; i < nb; ++i) wrench[i] = define(prog, wrench[i]);
+
+  // Backward pass: composite wrenches and composite inertias.
+  std::vector<Spatial> Fc = wrench;
+  std::vector<SpatialInertia> Ic(nb);
+  for (std::size_t i = 0; i < nb; ++i) Ic[i] = kin.bodies[i].inertia;
+  for (std::size_t i = nb; i-- > 0;) {
+    Fc[i] = define(prog, Fc[i]);
+    Ic[i].m = prog.define(Ic[i].m);
+    Ic[i].h = define(prog, Ic[i].h);
+    Ic[i].J = define(prog, Ic[i].J);
+    int p = kin.bodies[i].parent;
+    if (p < 0) continue;
+    auto up = static_cast<std::size_t>(p);
+    Fc[up] = add(Fc[up], Fc[i]);
+    Ic[up].m = Ic[up].m + Ic[i].m;
+    Ic[up].h = add(Ic[up].h, Ic[i].h);
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < 3; ++c) Ic[up].J[a][c] = Ic[up].J[a][c] + Ic[i].J[a][c];
+  }
+
+  // Residual k − q from the joints, M from composite inertias.
+  eq.residual.assign(f, 0);
+  struct Column { std::size_t body; const Spatial* phi; Spatial force; };
+  std::vector<std::vector<Column>> by_coordinate(f);
+  for (std::size_t i = 0; i < nb; ++i)
+    for (const auto& col : kin.bodies[i].columns) {
+      auto j = static_cast<std::size_t>(col.coordinate);
+      eq.residual[j] += dot(col.phi, Fc[i]);
+      by_coordinate[j].push_back({i, &col.phi, define(prog, apply(Ic[i], col.phi))});
+    }
+  eq.M.assign(f, std::vector<ex>(f, 0));
+  for (std::size_t j = 0; j < f; ++j)
+    for (std::size_t k = j; k < f; ++k) {
+      ex m = 0;
+      for (const auto& a : by_coordinate[j])
+        for (const auto& b : by_coordinate[k]) {
+          int ia = static_cast<int>(a.body), ib = static_cast<int>(b.body);
+          if (kin.is_ancestor_or_self(ia, ib))
+            m += dot(*a.phi, b.force);
+          else if (kin.is_ancestor_or_self(ib, ia))
+            m += dot(*b.phi, a.force);
+        }
+      eq.M[j][k] = eq.M[k][j] = m;
+    }
+
+  // Conservative and dissipative elements: q = −∂V/∂y − ∂R/∂ẏ.
+  ex V = 0, R = 0;
+  for (const auto& s : model.springs()) {
+    Vec3 d = define(prog, sub(kin.marker_position(model, prog, s.marker_b),
+                              kin.marker_position(model, prog, s.marker_a)));
+    ex L2 = prog.define(dot(d, d));
+    if (s.rest_length.is_zero())
+      V += s.stiffness * L2 / 2;
+    else
+      V += s.stiffness * GiNaC::pow(GiNaC::sqrt(L2) - s.rest_length, 2) / 2;
+  }
+  for (const auto& dmp : model.dampers()) {
+    Vec3 d = define(prog, sub(kin.marker_position(model, prog, dmp.marker_b),
+                              kin.marker_position(model, prog, dmp.marker_a)));
+    Vec3 dd = define(prog, sub(kin.marker_velocity(model, prog, dmp.marker_b),
+                               kin.marker_velocity(model, prog, dmp.marker_a)));
+    // L̇ = dᵀḋ / L, so R = ½ c (dᵀḋ)² / (dᵀd).
+    ex Ldot_L = prog.define(dot(d, dd));
+    R += dmp.damping * Ldot_L * Ldot_L / (2 * prog.define(dot(d, d)));
+  }
+  for (const auto& b : model.bushings()) {
+    Mat3 Sa = kin.marker_frame(model, prog, b.marker_a);
+    Mat3 Sb = kin.marker_frame(model, prog, b.marker_b);
+    Vec3 ra = kin.marker_position(model, prog, b.marker_a);
+    Vec3 rb = kin.marker_position(model, prog, b.marker_b);
+    Vec3 d = define(prog, sub(rb, ra));
+    Vec3 dr = define(prog, mul_transposed(Sa, d));
+    Mat3 Srel = define(prog, mul(transpose(Sa), Sb));
+    Vec3 theta = {(Srel[2][1] - Srel[1][2]) / 2, (Srel[0][2] - Srel[2][0]) / 2,
+                  (Srel[1][0] - Srel[0][1]) / 2};
+    theta = define(prog, theta);
+    Vec3 wa = kin.marker_angular_velocity(model, b.marker_a);
+    Vec3 wb = kin.marker_angular_velocity(model, b.marker_b);
+    Vec3 va = kin.marker_velocity(model, prog, b.marker_a);
+    Vec3 vb = kin.marker_velocity(model, prog, b.marker_b);
+    // Rates in frame a: Δṙ = S_aᵀ(v_b − v_a − ω_a × d), ω_rel = S_aᵀ(ω_b − ω_a).
+    Vec3 drdot = define(prog, mul_transposed(Sa, sub(sub(vb, va), cross(wa, d))));
+    Vec3 wrel = define(prog, mul_transposed(Sa, sub(wb, wa)));
+    for (int a = 0; a < 3; ++a) {
+      V += b.k_translation[a] * dr[a] * dr[a] / 2 + b.k_rotation[a] * theta[a] * theta[a] / 2;
+      R += b.d_translation[a] * drdot[a] * drdot[a] / 2 + b.d_rotation[a] * wrel[a] * wrel[a] / 2;
+    }
+  }
+  if (!V.is_zero() || !R.is_zero()) {
+    ex Vd = prog.define(V), Rd = prog.define(R);
+    for (std::size_t j = 0; j < f; ++j)
+      eq.residual[j] += prog.diff(Vd, eq.y[j]) + prog.diff(Rd, eq.yd[j]);
+  }
+  for (const auto& g : model.generalized_forces())
+    eq.residual[static_cast<std::size_t>(model.coordinate_index(g.coordinate))] -= g.value;
+
+  // Outputs.
+  for (const auto& o : model.outputs()) {
+    switch (o.kind) {
+      case OutputKind::position:
+        eq.outputs.push_back(dot(o.direction, kin.marker_position(model, prog, o.marker)));
+        break;
+      case OutputKind::velocity:
+        eq.outputs.push_back(dot(o.direction, kin.marker_velocity(model, prog, o.marker)));
+        break;
+      case OutputKind::coordinate:
+        eq.outputs.push_back(eq.y[static_cast<std::size_t>(model.coordinate_index(o.coordinate))]);
+        break;
+      case OutputKind::rate:
+        eq.outputs.push_back(eq.yd[static_cast<std::size_t>(model.coordinate_index(o.coordinate))]);
+        break;
+      case OutputKind::expression:
+        eq.outputs.push_back(o.expression);
+        break;
+    }
+  }
+
+  // Body Jacobians (for the invariant M = J̄ᵀ M̄ J̄): J̄_i is the sum of φ along the root path,
+  // and the centre-of-mass velocity is v_O + ω × c.
+  eq.JT.assign(3 * nb, std::vector<ex>(f, 0));
+  eq.JR.assign(3 * nb, std::vector<ex>(f, 0));
+  for (std::size_t i = 0; i < nb; ++i)
+    for (int k = static_cast<int>(i); k >= 0; k = kin.bodies[static_cast<std::size_t>(k)].parent)
+      for (const auto& col : kin.bodies[static_cast<std::size_t>(k)].columns) {
+        Vec3 vc = add(col.phi.v, cross(col.phi.w, kin.bodies[i].com));
+        for (int a = 0; a < 3; ++a) {
+          auto j = static_cast<std::size_t>(col.coordinate);
+          eq.JT[3 * i + static_cast<std::size_t>(a)][j] += vc[a];
+          eq.JR[3 * i + static_cast<std::size_t>(a)][j] += col.phi.w[a];
+        }
+      }
+  return eq;
+}
+
+}  // namespace mbsgen

@@ -1,0 +1,516 @@
+#include "mbsgen/generator/emit.hpp"
+
+#include "mbsgen/generator/cse.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace mbsgen {
+
+using GiNaC::ex;
+using GiNaC::ex_to;
+using GiNaC::is_a;
+
+std::string identifier(const std::string& name) {
+  std::string id;
+  for (char c : name) id += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  if (id.empty() || std::isdigit(static_cast<unsigned char>(id[0]))) id = "m_" + id;
+  return id;
+}
+
+namespace {
+
+std::string format_double(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  std::string s = buf;
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+// Prints GiNaC expressions as C++ and counts the operations it writes.
+class CppPrinter {
+ public:
+  std::unordered_map<ex, std::string, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> names;
+  std::size_t operations = 0;
+
+  std::string print(const ex& e) {
+    bool negative = false;
+    std::string s = term(e, negative);
+    if (negative) {
+      ++operations;
+      return "-" + wrap_if_sum(e, s);
+    }
+    return s;
+  }
+
+ private:
+  static bool is_sum(const ex& e) { return is_a<GiNaC::add>(e); }
+  std::string wrap_if_sum(const ex& e, const std::string& s) {
+    ex a = e;
+    if (is_a<GiNaC::mul>(e)) return s;  // products bind tighter than unary minus
+    return is_sum(a) ? "(" + s + ")" : s;
+  }
+
+  std::string number(const GiNaC::numeric& n) {
+    if (!n.is_real()) throw std::runtime_error("mbsgen: complex number in generated code");
+    if (n.is_integer() && GiNaC::abs(n) < GiNaC::numeric(1L << 53))
+      return format_double(n.to_double());
+    return format_double(n.to_double());
+  }
+
+  // Prints e without its sign when it is a negative number or a product with a negative
+  // coefficient; sets negative accordingly.
+  std::string term(const ex& e, bool& negative) {
+    negative = false;
+    if (auto it = names.find(e); it != names.end()) return it->second;
+    if (is_a<GiNaC::numeric>(e)) {
+      GiNaC::numeric n = ex_to<GiNaC::numeric>(e);
+      if (n.is_negative()) {
+        negative = true;
+        n = -n;
+      }
+      return number(n);
+    }
+    if (is_a<GiNaC::constant>(e)) return number(ex_to<GiNaC::numeric>(GiNaC::evalf(e)));
+    if (is_a<GiNaC::symbol>(e))
+      throw std::runtime_error("mbsgen: unbound symbol in generated code: " +
+                               ex_to<GiNaC::symbol>(e).get_name());
+    if (is_a<GiNaC::add>(e)) {
+      std::string s;
+      for (std::size_t i = 0; i < e.nops(); ++i) {
+        bool neg = false;
+        std::string t = term(e.op(i), neg);
+        if (is_sum(e.op(i))) t = "(" + t + ")";
+        if (i == 0) {
+          if (neg) ++operations;
+          s = neg ? "-" + t : t;
+        } else {
+          ++operations;
+          s += neg ? " - " + t : " + " + t;
+        }
+      }
+      return s;
+    }
+    if (is_a<GiNaC::mul>(e)) {
+      std::vector<std::string> num, den;
+      for (std::size_t i = 0; i < e.nops(); ++i) {
+        const ex& f = e.op(i);
+        if (is_a<GiNaC::numeric>(f)) {
+          GiNaC::numeric n = ex_to<GiNaC::numeric>(f);
+          if (n.is_negative()) {
+            negative = !negative;
+            n = -n;
+          }
+          if (n != 1) num.push_back(number(n));
+          continue;
+        }
+        if (is_a<GiNaC::power>(f) && is_a<GiNaC::numeric>(f.op(1)) &&
+            ex_to<GiNaC::numeric>(f.op(1)).is_integer() && ex_to<GiNaC::numeric>(f.op(1)).is_negative()) {
+          den.push_back(factor(GiNaC::pow(f.op(0), -f.op(1))));
+          continue;
+        }
+        num.push_back(factor(f));
+      }
+      std::string s;
+      for (std::size_t i = 0; i < num.size(); ++i) {
+        if (i) ++operations;
+        s += (i ? "*" : "") + num[i];
+      }
+      if (num.empty()) s = "1.0";
+      for (const auto& d : den) {
+        ++operations;
+        s += "/" + d;
+      }
+      return s;
+    }
+    if (is_a<GiNaC::power>(e)) {
+      const ex& b = e.op(0);
+      const ex& x = e.op(1);
+      if (is_a<GiNaC::numeric>(x)) {
+        GiNaC::numeric n = ex_to<GiNaC::numeric>(x);
+        if (n.is_integer()) {
+          long k = n.to_long();
+          std::string base = factor(b);
+          std::string s = base;
+          for (long i = 1; i < std::labs(k); ++i) {
+            ++operations;
+            s += "*" + base;
+          }
+          if (std::labs(k) > 1) s = "(" + s + ")";
+          if (k < 0) {
+            ++operations;
+            s = "1.0/" + s;
+          }
+          return s;
+        }
+        if (n == GiNaC::numeric(1, 2)) {
+          ++operations;
+          return "std::sqrt(" + print(b) + ")";
+        }
+        if (n == GiNaC::numeric(-1, 2)) {
+          operations += 2;
+          return "(1.0/std::sqrt(" + print(b) + "))";
+        }
+      }
+      ++operations;
+      return "std::pow(" + print(b) + ", " + print(x) + ")";
+    }
+    if (is_a<GiNaC::function>(e)) {
+      static const std::map<std::string, std::string> known = {
+          {"sin", "std::sin"},   {"cos", "std::cos"},   {"tan", "std::tan"},   {"exp", "std::exp"},
+          {"log", "std::log"},   {"abs", "std::fabs"},  {"asin", "std::asin"}, {"acos", "std::acos"},
+          {"atan", "std::atan"}, {"atan2", "std::atan2"}, {"sinh", "std::sinh"}, {"cosh", "std::cosh"},
+          {"tanh", "std::tanh"}, {"asinh", "std::asinh"}, {"acosh", "std::acosh"},
+          {"atanh", "std::atanh"}};
+      std::string fname = ex_to<GiNaC::function>(e).get_name();
+      auto it = known.find(fname);
+      if (it == known.end())
+        throw std::runtime_error("mbsgen: function '" + fname + "' cannot be emitted as C++");
+      ++operations;
+      std::string s = it->second + "(";
+      for (std::size_t i = 0; i < e.nops(); ++i) s += (i ? ", " : "") + print(e.op(i));
+      return s + ")";
+    }
+    throw std::runtime_error("mbsgen: cannot emit expression of this kind");
+  }
+
+  // A factor of a product: parenthesised when it is a sum or carries a sign.
+  std::string factor(const ex& e) {
+    bool neg = false;
+    std::string s = term(e, neg);
+    if (neg) {
+      ++operations;
+      return "(-" + (is_sum(e) ? "(" + s + ")" : s) + ")";
+    }
+    return is_sum(e) ? "(" + s + ")" : s;
+  }
+};
+
+struct Argument {
+  std::string name;
+  std::vector<ex> symbols;  // bound to name[i]
+};
+struct Buffer {
+  std::string name;
+  std::vector<ex> values;  // name[i] = values[i]
+  std::string doc;
+};
+struct Kernel {
+  std::string name, doc;
+  std::vector<Argument> inputs;
+  std::vector<Buffer> outputs;
+};
+
+std::vector<ex> column_major(const ExMatrix& A, std::size_t rows, std::size_t cols) {
+  std::vector<ex> v;
+  v.reserve(rows * cols);
+  for (std::size_t j = 0; j < cols; ++j)
+    for (std::size_t i = 0; i < rows; ++i) v.push_back(A[i][j]);
+  return v;
+}
+
+std::string json_string(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\t': o += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char b[8];
+          std::snprintf(b, sizeof b, "\\u%04x", c);
+          o += b;
+        } else {
+          o += c;
+        }
+    }
+  }
+  return o + "\"";
+}
+
+struct EmittedKernel {
+  std::string code;
+  KernelInfo info;
+};
+
+EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog, bool cse) {
+  // Intermediates reachable from the outputs, in definition order.
+  std::vector<char> needed(prog.definitions().size(), 0);
+  std::vector<ex> stack;
+  for (const auto& b : k.outputs)
+    for (const auto& v : b.values) stack.push_back(v);
+  while (!stack.empty()) {
+    ex e = stack.back();
+    stack.pop_back();
+    if (is_a<GiNaC::symbol>(e)) {
+      long i = prog.index_of(e);
+      if (i >= 0 && !needed[static_cast<std::size_t>(i)]) {
+        needed[static_cast<std::size_t>(i)] = 1;
+        stack.push_back(prog.definitions()[static_cast<std::size_t>(i)].value);
+      }
+      continue;
+    }
+    for (std::size_t i = 0; i < e.nops(); ++i) stack.push_back(e.op(i));
+  }
+  std::vector<Statement> statements;
+  for (std::size_t i = 0; i < needed.size(); ++i)
+    if (needed[i]) {
+      const auto& d = prog.definitions()[i];
+      statements.push_back({d.symbol.get_name(), d.value, true, d.symbol});
+    }
+  for (const auto& b : k.outputs)
+    for (std::size_t i = 0; i < b.values.size(); ++i)
+      statements.push_back({b.name + "[" + std::to_string(i) + "]", b.values[i], false, GiNaC::ex()});
+  if (cse) statements = eliminate_common_subexpressions(statements);
+
+  CppPrinter printer;
+  for (const auto& a : k.inputs)
+    for (std::size_t i = 0; i < a.symbols.size(); ++i)
+      printer.names[a.symbols[i]] = a.name + "[" + std::to_string(i) + "]";
+  std::ostringstream body;
+  for (const auto& s : statements) {
+    std::string rhs = printer.print(s.value);
+    if (s.temporary) {
+      body << "  const double " << s.target << " = " << rhs << ";\n";
+      printer.names[s.symbol] = s.target;
+    } else {
+      body << "  " << s.target << " = " << rhs << ";\n";
+    }
+  }
+
+  std::ostringstream sig;
+  sig << "int " << id << "_" << k.name << "(";
+  bool first = true;
+  for (const auto& a : k.inputs) {
+    sig << (first ? "" : ", ") << "const double* " << a.name;
+    first = false;
+  }
+  for (const auto& b : k.outputs) {
+    sig << (first ? "" : ", ") << "double* " << b.name;
+    first = false;
+  }
+  sig << ")";
+
+  std::ostringstream code;
+  code << "// " << k.doc << "\n// operations: " << printer.operations << "\n";
+  code << "extern \"C\" " << sig.str() << " {\n";
+  for (const auto& a : k.inputs)
+    if (a.symbols.empty()) code << "  (void)" << a.name << ";\n";
+  code << body.str();
+  code << "  int status = 0;\n";
+  for (const auto& b : k.outputs)
+    if (!b.values.empty())
+      code << "  if (!all_finite(" << b.name << ", " << b.values.size() << ")) status = 1;\n";
+  code << "  return status;\n}\n\n";
+  return {code.str(), {k.name, sig.str(), printer.operations}};
+}
+
+}  // namespace
+
+GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin,
+                   const EmitOptions& options) {
+  GeneratedCode out;
+  out.id = identifier(model.name());
+  const std::size_t f = eq.y.size(), m = eq.u.size(), r = eq.outputs.size();
+  const std::size_t nb = model.bodies().size();
+  std::vector<ex> y(eq.y.begin(), eq.y.end()), yd(eq.yd.begin(), eq.yd.end()),
+      u(eq.u.begin(), eq.u.end()), p(eq.p.begin(), eq.p.end());
+
+  std::vector<Kernel> kernels;
+  kernels.push_back({"mass_matrix", "M(y, p): f×f mass matrix, column-major",
+                     {{"y", y}, {"p", p}},
+                     {{"M", column_major(eq.M, f, f), ""}}});
+  kernels.push_back({"residual", "k(y, yd) − q(y, yd, u): length f (M(y) ydd + k − q = 0)",
+                     {{"y", y}, {"yd", yd}, {"u", u}, {"p", p}},
+                     {{"r", eq.residual, ""}}});
+  std::vector<ex> none;
+  kernels.push_back({"linear",
+                     "linearized M, Q, K (f×f), B (f×m), C_y, C_v (r×f) at (y0, yd0), column-major",
+                     {{"y0", y}, {"yd0", lin.at_rest ? none : yd}, {"p", p}},
+                     {{"M", column_major(lin.M, f, f), ""},
+                      {"Q", column_major(lin.Q, f, f), ""},
+                      {"K", column_major(lin.K, f, f), ""},
+                      {"B", column_major(lin.B, f, m), ""},
+                      {"Cy", column_major(lin.Cy, r, f), ""},
+                      {"Cv", column_major(lin.Cv, r, f), ""}}});
+  kernels.push_back({"linear_structured",
+                     "M, damping D = sym Q, gyroscopic G = skew Q, stiffness sym K, circulatory "
+                     "N = skew K at (y0, yd0), column-major",
+                     {{"y0", y}, {"yd0", lin.at_rest ? none : yd}, {"p", p}},
+                     {{"M", column_major(lin.M, f, f), ""},
+                      {"D", column_major(lin.D, f, f), ""},
+                      {"G", column_major(lin.G, f, f), ""},
+                      {"Ks", column_major(lin.Ks, f, f), ""},
+                      {"N", column_major(lin.N, f, f), ""}}});
+  kernels.push_back({"operating_point",
+                     "operating point y0 (or the initial guess of an equilibrium) and steady rates yd0",
+                     {{"p", p}},
+                     {{"y0", lin.y0, ""}, {"yd0", lin.yd0, ""}}});
+  kernels.push_back({"outputs", "outputs z(y, yd): length r", {{"y", y}, {"yd", yd}, {"p", p}},
+                     {{"z", eq.outputs, ""}}});
+  std::vector<ex> rc, S, JT, JR, mass, Ic;
+  for (std::size_t i = 0; i < nb; ++i) {
+    const BodyKinematics& b = eq.kinematics.bodies[i];
+    for (int a = 0; a < 3; ++a) rc.push_back(b.com[a]);
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) S.push_back(b.S[a][c]);
+    mass.push_back(b.inertia.m);
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) Ic.push_back(b.I_com[a][c]);
+  }
+  for (std::size_t i = 0; i < nb; ++i)
+    for (std::size_t j = 0; j < f; ++j)
+      for (std::size_t a = 0; a < 3; ++a) {
+        JT.push_back(eq.JT[3 * i + a][j]);
+        JR.push_back(eq.JR[3 * i + a][j]);
+      }
+  kernels.push_back({"bodies",
+                     "per body: centre of mass rc (3), rotation S (3×3), Jacobians JT, JR (3×f, "
+                     "centre-of-mass velocity and angular velocity in the world frame), mass m and "
+                     "inertia Ic about the centre of mass in the world frame (3×3)",
+                     {{"y", y}, {"p", p}},
+                     {{"rc", rc, ""}, {"S", S, ""}, {"JT", JT, ""}, {"JR", JR, ""},
+                      {"m", mass, ""}, {"Ic", Ic, ""}}});
+
+  std::ostringstream kernel_code;
+  for (const auto& k : kernels) {
+    EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse);
+    kernel_code << ek.code;
+    out.kernels.push_back(ek.info);
+  }
+
+  const std::string banner =
+      std::string("// Generated by mbsgen ") + kGeneratorVersion + " from model '" + model.name() +
+      "' (scene '" + options.scene + "')" +
+      (options.source_file.empty() ? "" : ", file " + std::filesystem::path(options.source_file).filename().string()) +
+      ".\n// Generated code: do not edit. Regenerate with `mbsgen generate`.\n";
+  std::ostringstream ops;
+  ops << "// Operation counts (+, -, *, /, calls):";
+  for (const auto& k : out.kernels) ops << " " << k.name << " " << k.operations << ";";
+  ops << "\n";
+
+  std::ostringstream h;
+  h << banner << ops.str() << "#pragma once\n\n";
+  h << "#define " << out.id << "_ABI_VERSION " << kAbiVersion << "\n\n";
+  h << "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
+  h << "enum {\n  " << out.id << "_n_coordinates = " << f << ",\n  " << out.id
+    << "_n_inputs = " << m << ",\n  " << out.id << "_n_outputs = " << r << ",\n  " << out.id
+    << "_n_parameters = " << p.size() << ",\n  " << out.id << "_n_bodies = " << nb << ",\n  "
+    << out.id << "_at_rest = " << (lin.at_rest ? 1 : 0) << "\n};\n\n";
+  h << "int " << out.id << "_abi_version(void);\n";
+  h << "extern const char* const " << out.id << "_coordinate_names[];\n";
+  h << "extern const char* const " << out.id << "_parameter_names[];\n";
+  h << "extern const double " << out.id << "_parameter_defaults[];\n";
+  h << "extern const char* const " << out.id << "_input_names[];\n";
+  h << "extern const char* const " << out.id << "_output_names[];\n\n";
+  for (const auto& k : out.kernels) h << k.signature << ";\n";
+  h << "\n#ifdef __cplusplus\n}\n#endif\n";
+  out.header = h.str();
+
+  auto names_array = [&](const std::string& what, const std::vector<std::string>& names) {
+    std::ostringstream s;
+    s << "extern \"C\" const char* const " << out.id << "_" << what << "[] = {";
+    for (const auto& n : names) s << json_string(n) << ", ";
+    s << "nullptr};\n";
+    return s.str();
+  };
+  std::vector<std::string> cn, pn, in, on;
+  for (const auto& c : model.coordinates()) cn.push_back(c.name);
+  for (const auto& q : model.parameters()) pn.push_back(q.name);
+  for (const auto& i : model.inputs()) in.push_back(i.name);
+  for (const auto& o : model.outputs()) on.push_back(o.name);
+
+  std::ostringstream c;
+  c << banner << ops.str() << "#include \"" << out.id << ".hpp\"\n\n#include <cmath>\n\n";
+  c << "namespace {\nbool all_finite(const double* x, int n) {\n  for (int i = 0; i < n; ++i)\n"
+       "    if (!std::isfinite(x[i])) return false;\n  return true;\n}\n}  // namespace\n\n";
+  c << "extern \"C\" int " << out.id << "_abi_version(void) { return " << kAbiVersion << "; }\n";
+  c << names_array("coordinate_names", cn) << names_array("parameter_names", pn)
+    << names_array("input_names", in) << names_array("output_names", on);
+  c << "extern \"C\" const double " << out.id << "_parameter_defaults[] = {";
+  for (const auto& q : model.parameters()) c << format_double(q.value) << ", ";
+  c << "0.0};\n\n";
+  c << kernel_code.str();
+  out.source = c.str();
+
+  // Manifest.
+  std::ostringstream j;
+  j << "{\n  \"generator\": \"mbsgen " << kGeneratorVersion << "\",\n  \"abi_version\": " << kAbiVersion
+    << ",\n  \"model\": " << json_string(model.name()) << ",\n  \"scene\": " << json_string(options.scene)
+    << ",\n  \"id\": " << json_string(out.id) << ",\n  \"coordinates\": [";
+  for (std::size_t i = 0; i < f; ++i)
+    j << (i ? ", " : "") << "{\"name\": " << json_string(model.coordinates()[i].name)
+      << ", \"unit\": " << json_string(model.coordinates()[i].unit) << "}";
+  j << "],\n  \"parameters\": [";
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto& q = model.parameters()[i];
+    j << (i ? ",\n    " : "\n    ") << "{\"name\": " << json_string(q.name)
+      << ", \"value\": " << format_double(q.value) << ", \"unit\": " << json_string(q.unit)
+      << ", \"source\": " << json_string(q.source) << "}";
+  }
+  j << "],\n  \"inputs\": [";
+  for (std::size_t i = 0; i < m; ++i)
+    j << (i ? ", " : "") << "{\"name\": " << json_string(model.inputs()[i].name)
+      << ", \"unit\": " << json_string(model.inputs()[i].unit) << "}";
+  j << "],\n  \"outputs\": [";
+  for (std::size_t i = 0; i < r; ++i)
+    j << (i ? ", " : "") << "{\"name\": " << json_string(model.outputs()[i].name)
+      << ", \"unit\": " << json_string(model.outputs()[i].unit) << "}";
+  j << "],\n  \"bodies\": [";
+  for (std::size_t i = 0; i < nb; ++i) j << (i ? ", " : "") << json_string(model.bodies()[i].name);
+  j << "],\n  \"operating_point\": {\"kind\": "
+    << (lin.equilibrium ? "\"equilibrium\"" : "\"given\"") << ", \"at_rest\": "
+    << (lin.at_rest ? "true" : "false") << "},\n  \"kernels\": [";
+  for (std::size_t i = 0; i < out.kernels.size(); ++i)
+    j << (i ? "," : "") << "\n    {\"name\": " << json_string(out.kernels[i].name)
+      << ", \"operations\": " << out.kernels[i].operations
+      << ", \"signature\": " << json_string(out.kernels[i].signature) << "}";
+  j << "\n  ]\n}\n";
+  out.manifest = j.str();
+  return out;
+}
+
+namespace {
+
+void write_atomically(const std::filesystem::path& path, const std::string& content) {
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (in) {
+      std::ostringstream old;
+      old << in.rdbuf();
+      if (old.str() == content) return;
+    }
+  }
+  std::filesystem::path tmp = path;
+  tmp += ".tmp";
+  {
+    std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
+    if (!o) throw std::runtime_error("cannot write " + tmp.string());
+    o << content;
+    o.close();
+    if (!o) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace
+
+void write_generated(const GeneratedCode& code, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path d(dir);
+  write_atomically(d / (code.id + ".hpp"), code.header);
+  write_atomically(d / (code.id + ".cpp"), code.source);
+  write_atomically(d / (code.id + ".json"), code.manifest);
+}
+
+}  // namespace mbsgen

@@ -1,0 +1,321 @@
+#include "mbsgen/generator/model.hpp"
+
+#include <cmath>
+#include <functional>
+#include <set>
+#include <sstream>
+
+namespace mbsgen {
+
+std::string SourceLocation::str() const {
+  std::ostringstream os;
+  os << (file.empty() ? "<model>" : file);
+  if (line > 0) {
+    os << ':' << line;
+    if (column > 0) os << ':' << column;
+  }
+  return os.str();
+}
+
+ModelError::ModelError(const SourceLocation& where, const std::string& what)
+    : std::runtime_error(where.str() + ": error: " + what), where_(where), message_(what) {}
+
+Vec3 zero_vec3() { return {GiNaC::ex(0), GiNaC::ex(0), GiNaC::ex(0)}; }
+
+Mat3 zero_mat3() {
+  Mat3 m;
+  for (auto& row : m) row = zero_vec3();
+  return m;
+}
+
+Mat3 identity_mat3() {
+  Mat3 m = zero_mat3();
+  for (int i = 0; i < 3; ++i) m[i][i] = 1;
+  return m;
+}
+
+Model::Model(std::string name) : name_(std::move(name)) {}
+
+void Model::check_new_symbol(const std::string& name, const SourceLocation& where) {
+  static const std::set<std::string> reserved = {"sin", "cos", "tan", "exp", "log", "sqrt", "abs",
+                                                 "asin", "acos", "atan", "atan2", "sinh", "cosh",
+                                                 "tanh", "Pi", "I", "pow", "world"};
+  if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_'))
+    throw ModelError(where, "'" + name + "' is not a valid name (letters, digits and _)");
+  for (char c : name)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_'))
+      throw ModelError(where, "'" + name + "' is not a valid name (letters, digits and _)");
+  if (reserved.count(name)) throw ModelError(where, "'" + name + "' is a reserved name");
+  auto it = symbol_names_.find(name);
+  if (it != symbol_names_.end())
+    throw ModelError(where, "'" + name + "' is already defined at " + it->second.str());
+  symbol_names_.emplace(name, where);
+}
+
+void Model::check_new_element(const std::string& name, const char* kind,
+                              const SourceLocation& where) {
+  if (name.empty()) throw ModelError(where, std::string("a ") + kind + " needs a name");
+  if (name == kWorld) throw ModelError(where, "'world' is reserved for the inertial frame");
+  auto it = element_names_.find(name);
+  if (it != element_names_.end())
+    throw ModelError(where, std::string("duplicate name '") + name + "': a " + it->second.first +
+                                " of that name is defined at " + it->second.second.str());
+  element_names_.emplace(name, std::make_pair(std::string(kind), where));
+}
+
+const GiNaC::symbol& Model::add_parameter(const std::string& name, double value,
+                                          const std::string& unit, const std::string& source,
+                                          const SourceLocation& where) {
+  check_new_symbol(name, where);
+  if (!std::isfinite(value))
+    throw ModelError(where, "parameter '" + name + "' has a non-finite value");
+  Parameter p;
+  p.name = name;
+  p.value = value;
+  p.unit = unit;
+  p.source = source;
+  p.symbol = GiNaC::symbol(name);
+  p.where = where;
+  parameters_.push_back(p);
+  symtab_[name] = parameters_.back().symbol;
+  return parameters_.back().symbol;
+}
+
+const Coordinate& Model::add_coordinate(const std::string& name, const std::string& unit,
+                                        const SourceLocation& where) {
+  check_new_symbol(name, where);
+  check_new_symbol(name + "_dot", where);
+  Coordinate c;
+  c.name = name;
+  c.unit = unit;
+  c.position = GiNaC::symbol(name);
+  c.velocity = GiNaC::symbol(name + "_dot");
+  c.where = where;
+  coordinates_.push_back(c);
+  symtab_[name] = coordinates_.back().position;
+  symtab_[name + "_dot"] = coordinates_.back().velocity;
+  return coordinates_.back();
+}
+
+const GiNaC::symbol& Model::add_input(const std::string& name, const std::string& unit,
+                                      const SourceLocation& where) {
+  check_new_symbol(name, where);
+  inputs_.push_back({name, unit, where});
+  input_symbols_.push_back(GiNaC::symbol(name));
+  symtab_[name] = input_symbols_.back();
+  return input_symbols_.back();
+}
+
+void Model::add_body(Body body) {
+  check_new_element(body.name, "body", body.where);
+  body_index_[body.name] = static_cast<int>(bodies_.size());
+  bodies_.push_back(std::move(body));
+}
+
+void Model::add_marker(Marker marker) {
+  check_new_element(marker.name, "marker", marker.where);
+  marker_index_[marker.name] = static_cast<int>(markers_.size());
+  markers_.push_back(std::move(marker));
+}
+
+void Model::add_gravity(Gravity gravity) {
+  check_new_element(gravity.name, "force", gravity.where);
+  gravity_.push_back(std::move(gravity));
+}
+void Model::add_spring(Spring spring) {
+  check_new_element(spring.name, "force", spring.where);
+  springs_.push_back(std::move(spring));
+}
+void Model::add_damper(Damper damper) {
+  check_new_element(damper.name, "force", damper.where);
+  dampers_.push_back(std::move(damper));
+}
+void Model::add_bushing(Bushing bushing) {
+  check_new_element(bushing.name, "force", bushing.where);
+  bushings_.push_back(std::move(bushing));
+}
+void Model::add_generalized_force(GeneralizedForce force) {
+  check_new_element(force.name, "force", force.where);
+  generalized_forces_.push_back(std::move(force));
+}
+void Model::add_applied_force(AppliedForce force) {
+  check_new_element(force.name, "force", force.where);
+  applied_forces_.push_back(std::move(force));
+}
+void Model::add_output(Output output) {
+  check_new_element(output.name, "output", output.where);
+  outputs_.push_back(std::move(output));
+}
+
+GiNaC::ex Model::symbol(const std::string& name) const {
+  auto it = symtab_.find(name);
+  if (it == symtab_.end()) throw std::out_of_range("mbsgen::Model::symbol: unknown name '" + name + "'");
+  return it->second;
+}
+
+int Model::body_index(const std::string& name) const {
+  if (name == kWorld) return -1;
+  auto it = body_index_.find(name);
+  if (it == body_index_.end()) throw std::out_of_range("mbsgen::Model::body_index: unknown body '" + name + "'");
+  return it->second;
+}
+
+int Model::coordinate_index(const std::string& name) const {
+  for (std::size_t i = 0; i < coordinates_.size(); ++i)
+    if (coordinates_[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+bool Model::has_marker(const std::string& name) const { return marker_index_.count(name) != 0; }
+
+const Marker& Model::marker(const std::string& name) const {
+  auto it = marker_index_.find(name);
+  if (it == marker_index_.end()) throw std::out_of_range("mbsgen::Model::marker: unknown marker '" + name + "'");
+  return markers_[static_cast<std::size_t>(it->second)];
+}
+
+namespace {
+
+// Collects the symbols of an expression.
+void collect_symbols(const GiNaC::ex& e, std::set<std::string>& out) {
+  if (GiNaC::is_a<GiNaC::symbol>(e)) {
+    out.insert(GiNaC::ex_to<GiNaC::symbol>(e).get_name());
+    return;
+  }
+  for (std::size_t i = 0; i < e.nops(); ++i) collect_symbols(e.op(i), out);
+}
+
+double numeric_value(const GiNaC::ex& e, const GiNaC::exmap& defaults, bool& ok) {
+  GiNaC::ex v = GiNaC::evalf(e.subs(defaults));
+  ok = GiNaC::is_a<GiNaC::numeric>(v) && GiNaC::ex_to<GiNaC::numeric>(v).is_real();
+  return ok ? GiNaC::ex_to<GiNaC::numeric>(v).to_double() : 0.0;
+}
+
+}  // namespace
+
+void Model::validate() const {
+  std::set<std::string> known;
+  for (const auto& [name, sym] : symtab_) known.insert(name);
+  std::set<std::string> position_only;  // parameters and coordinates (no rates, no inputs)
+  for (const auto& p : parameters_) position_only.insert(p.name);
+  for (const auto& c : coordinates_) position_only.insert(c.name);
+  std::set<std::string> parameters_only;
+  for (const auto& p : parameters_) parameters_only.insert(p.name);
+
+  auto check_expr = [&](const GiNaC::ex& e, const SourceLocation& where, const std::string& what,
+                        const std::set<std::string>& allowed) {
+    std::set<std::string> syms;
+    collect_symbols(e, syms);
+    for (const auto& s : syms)
+      if (!allowed.count(s))
+        throw ModelError(where, what + " may not depend on '" + s + "'");
+  };
+  auto check_marker = [&](const std::string& name, const SourceLocation& where, const std::string& who) {
+    if (!has_marker(name)) {
+      std::string known_markers;
+      for (const auto& m : markers_) known_markers += (known_markers.empty() ? "" : ", ") + m.name;
+      throw ModelError(where, who + " names an unknown marker '" + name + "' (markers: " +
+                                  (known_markers.empty() ? "none" : known_markers) + ")");
+    }
+  };
+
+  GiNaC::exmap defaults;
+  for (const auto& p : parameters_) defaults[p.symbol] = GiNaC::numeric(p.value);
+
+  // The tree: every parent exists and is defined before its children (so no cycles).
+  std::set<std::string> seen;
+  for (const auto& b : bodies_) {
+    if (b.parent != kWorld && !body_index_.count(b.parent))
+      throw ModelError(b.where, "body '" + b.name + "' has an unknown parent '" + b.parent + "'");
+    if (b.parent != kWorld && !seen.count(b.parent))
+      throw ModelError(b.where, "body '" + b.name + "': parent '" + b.parent +
+                                    "' must be defined before its children (a cycle, or out of order)");
+    seen.insert(b.name);
+    for (const auto& t : b.translation) check_expr(t, b.where, "a body's translation", position_only);
+    for (const auto& r : b.rotations) check_expr(r.angle, b.where, "a rotation angle", position_only);
+    if (b.rotation_matrix)
+      for (const auto& row : *b.rotation_matrix)
+        for (const auto& x : row) check_expr(x, b.where, "a rotation matrix", position_only);
+    check_expr(b.mass, b.where, "a mass", parameters_only);
+    for (const auto& x : b.com) check_expr(x, b.where, "a centre of mass", parameters_only);
+    for (const auto& row : b.inertia)
+      for (const auto& x : row) check_expr(x, b.where, "an inertia tensor", parameters_only);
+    bool ok = false;
+    double m = numeric_value(b.mass, defaults, ok);
+    if (!ok || m < 0)
+      throw ModelError(b.where, "body '" + b.name + "' has a negative or non-numeric mass");
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (!(b.inertia[i][j] - b.inertia[j][i]).is_zero())
+          throw ModelError(b.where, "body '" + b.name + "': the inertia tensor is not symmetric");
+  }
+  for (const auto& m : markers_) {
+    if (m.body != kWorld && !body_index_.count(m.body))
+      throw ModelError(m.where, "marker '" + m.name + "' is on an unknown body '" + m.body + "'");
+    for (const auto& x : m.position) check_expr(x, m.where, "a marker position", parameters_only);
+  }
+  for (const auto& s : springs_) {
+    check_marker(s.marker_a, s.where, "spring '" + s.name + "'");
+    check_marker(s.marker_b, s.where, "spring '" + s.name + "'");
+    check_expr(s.stiffness, s.where, "a spring stiffness", parameters_only);
+    check_expr(s.rest_length, s.where, "a rest length", parameters_only);
+  }
+  for (const auto& d : dampers_) {
+    check_marker(d.marker_a, d.where, "damper '" + d.name + "'");
+    check_marker(d.marker_b, d.where, "damper '" + d.name + "'");
+    check_expr(d.damping, d.where, "a damping coefficient", parameters_only);
+  }
+  for (const auto& b : bushings_) {
+    check_marker(b.marker_a, b.where, "bushing '" + b.name + "'");
+    check_marker(b.marker_b, b.where, "bushing '" + b.name + "'");
+    for (const Vec3* v : {&b.k_translation, &b.k_rotation, &b.d_translation, &b.d_rotation})
+      for (const auto& x : *v) check_expr(x, b.where, "a bushing coefficient", parameters_only);
+  }
+  for (const auto& g : generalized_forces_) {
+    if (coordinate_index(g.coordinate) < 0)
+      throw ModelError(g.where, "generalized force '" + g.name + "' names an unknown coordinate '" +
+                                    g.coordinate + "'");
+    check_expr(g.value, g.where, "a generalized force", known);
+  }
+  for (const auto& f : applied_forces_) {
+    check_marker(f.marker, f.where, "force '" + f.name + "'");
+    for (const auto& x : f.force) check_expr(x, f.where, "a force", known);
+    for (const auto& x : f.torque) check_expr(x, f.where, "a torque", known);
+  }
+  for (const auto& g : gravity_)
+    for (const auto& x : g.g) check_expr(x, g.where, "gravity", parameters_only);
+  for (const auto& o : outputs_) {
+    switch (o.kind) {
+      case OutputKind::position:
+      case OutputKind::velocity:
+        check_marker(o.marker, o.where, "output '" + o.name + "'");
+        for (const auto& x : o.direction) check_expr(x, o.where, "an output direction", parameters_only);
+        break;
+      case OutputKind::coordinate:
+      case OutputKind::rate:
+        if (coordinate_index(o.coordinate) < 0)
+          throw ModelError(o.where, "output '" + o.name + "' names an unknown coordinate '" +
+                                        o.coordinate + "'");
+        break;
+      case OutputKind::expression: {
+        std::set<std::string> allowed = known;
+        for (const auto& i : inputs_) allowed.erase(i.name);
+        check_expr(o.expression, o.where, "an output expression", allowed);
+        break;
+      }
+    }
+  }
+  for (const auto& [name, value] : operating_point_.position) {
+    if (coordinate_index(name) < 0)
+      throw ModelError(operating_point_.where, "operating point names an unknown coordinate '" + name + "'");
+    check_expr(value, operating_point_.where, "an operating point", parameters_only);
+  }
+  for (const auto& [name, value] : operating_point_.velocity) {
+    if (coordinate_index(name) < 0)
+      throw ModelError(operating_point_.where, "operating point names an unknown coordinate '" + name + "'");
+    check_expr(value, operating_point_.where, "an operating point", parameters_only);
+  }
+  if (coordinates_.empty()) throw ModelError({}, "model '" + name_ + "' has no coordinates");
+}
+
+}  // namespace mbsgen

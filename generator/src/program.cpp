@@ -1,0 +1,191 @@
+#include "mbsgen/generator/program.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace mbsgen {
+
+using GiNaC::ex;
+using GiNaC::ex_to;
+using GiNaC::is_a;
+
+void Program::add_variable(const GiNaC::symbol& s) {
+  if (!defs_.empty())
+    throw std::logic_error("mbsgen::Program::add_variable: variables must precede definitions");
+  if (variable_index_.count(s)) return;
+  variable_index_.emplace(s, variables_.size());
+  variables_.push_back(s);
+}
+
+long Program::index_of(const ex& symbol) const {
+  auto it = def_index_.find(symbol);
+  return it == def_index_.end() ? -1 : static_cast<long>(it->second);
+}
+
+bool Program::bits_intersect(const Bits& a, const Bits& b) const {
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
+    if (a[i] & b[i]) return true;
+  return false;
+}
+
+Program::Bits Program::dependencies(const ex& e) const {
+  Bits bits((variables_.size() + 63) / 64, 0);
+  // Iterative walk: outputs can be long sums.
+  std::vector<ex> stack{e};
+  while (!stack.empty()) {
+    ex x = stack.back();
+    stack.pop_back();
+    if (is_a<GiNaC::symbol>(x)) {
+      if (auto d = def_index_.find(x); d != def_index_.end()) {
+        const Bits& b = deps_[d->second];
+        for (std::size_t i = 0; i < bits.size(); ++i) bits[i] |= b[i];
+      } else if (auto v = variable_index_.find(x); v != variable_index_.end()) {
+        bits[v->second / 64] |= std::uint64_t{1} << (v->second % 64);
+      }
+      continue;
+    }
+    for (std::size_t i = 0; i < x.nops(); ++i) stack.push_back(x.op(i));
+  }
+  return bits;
+}
+
+void Program::collect_intermediates(const ex& e, std::vector<std::size_t>& out) const {
+  std::vector<ex> stack{e};
+  while (!stack.empty()) {
+    ex x = stack.back();
+    stack.pop_back();
+    if (is_a<GiNaC::symbol>(x)) {
+      if (auto d = def_index_.find(x); d != def_index_.end()) out.push_back(d->second);
+      continue;
+    }
+    for (std::size_t i = 0; i < x.nops(); ++i) stack.push_back(x.op(i));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+// Functions (sin, cos, sqrt, …) and non-integer powers become intermediates of their own, so
+// that sin and cos of each angle are computed once however often derivatives recreate them.
+ex Program::intern_functions(const ex& e) {
+  if (is_a<GiNaC::symbol>(e) || is_a<GiNaC::numeric>(e)) return e;
+  bool is_function = is_a<GiNaC::function>(e);
+  bool is_root = is_a<GiNaC::power>(e) && !(is_a<GiNaC::numeric>(e.op(1)) &&
+                                            ex_to<GiNaC::numeric>(e.op(1)).is_integer());
+  if (!is_function && !is_root && e.nops() == 0) return e;
+  if (auto it = interned_.find(e); it != interned_.end()) return it->second;
+  struct InternChildren : GiNaC::map_function {
+    Program* self;
+    explicit InternChildren(Program* p) : self(p) {}
+    ex operator()(const ex& x) override { return self->intern_functions(x); }
+  } intern_children(this);
+  ex mapped = e.nops() > 0 ? e.map(intern_children) : e;
+  ex result = mapped;
+  if (is_function || is_root) result = define_node(mapped);
+  interned_.emplace(e, result);
+  return result;
+}
+
+ex Program::define(const ex& e0) {
+  if (is_a<GiNaC::numeric>(e0) || is_a<GiNaC::symbol>(e0)) return e0;
+  return define_node(intern_functions(e0));
+}
+
+ex Program::define_node(const ex& e) {
+  if (is_a<GiNaC::numeric>(e) || is_a<GiNaC::symbol>(e)) return e;
+  if (is_a<GiNaC::mul>(e) && e.nops() == 2 && is_a<GiNaC::numeric>(e.op(1)) &&
+      is_a<GiNaC::symbol>(e.op(0)))
+    return e;
+  if (auto it = interned_.find(e); it != interned_.end() && is_a<GiNaC::symbol>(it->second))
+    return it->second;
+  GiNaC::symbol t("t" + std::to_string(defs_.size()));
+  deps_.push_back(dependencies(e));
+  defs_.push_back({t, e});
+  def_index_.emplace(t, defs_.size() - 1);
+  interned_.emplace(e, t);
+  return t;
+}
+
+bool Program::depends_on(const ex& e, const GiNaC::symbol& x) {
+  auto v = variable_index_.find(x);
+  if (v == variable_index_.end())
+    throw std::logic_error("mbsgen::Program::depends_on: not a registered variable: " + x.get_name());
+  Bits b = dependencies(e);
+  return (b[v->second / 64] >> (v->second % 64)) & 1u;
+}
+
+ex Program::diff_intermediate(std::size_t k, std::size_t variable) {
+  if (!((deps_[k][variable / 64] >> (variable % 64)) & 1u)) return 0;
+  const std::uint64_t key = static_cast<std::uint64_t>(k) * variables_.size() + variable;
+  if (auto it = diff_memo_.find(key); it != diff_memo_.end()) return it->second;
+  ex value = defs_[k].value;  // copy: define() may reallocate defs_
+  ex d = define(diff(value, variables_[variable]));
+  diff_memo_.emplace(key, d);
+  return d;
+}
+
+ex Program::diff(const ex& e, const GiNaC::symbol& x) {
+  auto v = variable_index_.find(x);
+  if (v == variable_index_.end())
+    throw std::logic_error("mbsgen::Program::diff: not a registered variable: " + x.get_name());
+  const std::size_t var = v->second;
+  if (is_a<GiNaC::symbol>(e)) {
+    if (e.is_equal(x)) return 1;
+    if (auto d = def_index_.find(e); d != def_index_.end()) return diff_intermediate(d->second, var);
+    return 0;
+  }
+  std::vector<std::size_t> ts;
+  collect_intermediates(e, ts);
+  ex result = e.diff(x);
+  for (std::size_t k : ts) {
+    ex dt = diff_intermediate(k, var);
+    if (dt.is_zero()) continue;
+    result += e.diff(defs_[k].symbol) * dt;
+  }
+  return result;
+}
+
+ex Program::substitute_intermediate(std::size_t k, Substitution& s) {
+  if (!bits_intersect(deps_[k], s.mask_)) return defs_[k].symbol;
+  if (auto it = s.memo_.find(k); it != s.memo_.end()) return it->second;
+  ex value = defs_[k].value;
+  ex r = define(substitute(value, s));
+  s.memo_.emplace(k, r);
+  return r;
+}
+
+ex Program::substitute(const ex& e, Substitution& s) {
+  if (s.mask_.empty()) {
+    s.mask_.assign((variables_.size() + 63) / 64, 0);
+    for (const auto& [key, value] : s.values_) {
+      auto v = variable_index_.find(key);
+      if (v == variable_index_.end())
+        throw std::logic_error("mbsgen::Program::substitute: not a registered variable");
+      s.mask_[v->second / 64] |= std::uint64_t{1} << (v->second % 64);
+    }
+  }
+  std::vector<std::size_t> ts;
+  collect_intermediates(e, ts);
+  GiNaC::exmap m = s.values_;
+  for (std::size_t k : ts) {
+    ex r = substitute_intermediate(k, s);
+    if (!r.is_equal(defs_[k].symbol)) m[defs_[k].symbol] = r;
+  }
+  return e.subs(m, GiNaC::subs_options::no_pattern);
+}
+
+ex Program::inline_all(const ex& e) {
+  std::vector<std::size_t> ts;
+  collect_intermediates(e, ts);
+  GiNaC::exmap m;
+  for (std::size_t k : ts) {
+    auto it = inline_memo_.find(k);
+    if (it == inline_memo_.end()) {
+      ex value = defs_[k].value;
+      it = inline_memo_.emplace(k, inline_all(value)).first;
+    }
+    m[defs_[k].symbol] = it->second;
+  }
+  return e.subs(m, GiNaC::subs_options::no_pattern);
+}
+
+}  // namespace mbsgen
