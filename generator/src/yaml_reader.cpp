@@ -44,7 +44,7 @@ std::string suggestion(const std::string& word, const std::vector<std::string>& 
   std::string best_name;
   for (const auto& c : candidates) {
     const std::size_t d = detail::edit_distance(word, c);
-    if (d < best) {
+    if (d < best && d < word.size() && d < c.size()) {  // keep at least one letter in common
       best = d;
       best_name = c;
     }

@@ -1,0 +1,356 @@
+// Tests of the YAML model reader: every textbook model reads and validates; every bad model in
+// tests/data/bad_models fails with exactly the message its first line announces; decimal
+// literals are exact; defaults and conversions do what docs/model-format.md says.
+#include "mbsgen/generator/yaml_reader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using mbsgen::ModelError;
+namespace fs = std::filesystem;
+
+const std::string kSourceDir = MBSGEN_SOURCE_DIR;
+
+// Returns the message of the ModelError that reading `path` throws, or "" when none is thrown.
+std::string error_of_file(const std::string& path) {
+  try {
+    mbsgen::read_model_file(path);
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string error_of_string(const std::string& text) {
+  try {
+    mbsgen::read_model_string(text, "test.yaml");
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool same(const GiNaC::ex& a, const GiNaC::ex& b) { return (a - b).expand().is_zero(); }
+
+// ---------------------------------------------------------------------------------------------
+// Textbook models
+
+struct TextbookCase {
+  const char* file;
+  std::size_t coordinates;
+  std::size_t bodies;
+};
+
+class TextbookModel : public testing::TestWithParam<TextbookCase> {};
+
+TEST_P(TextbookModel, ReadsAndValidates) {
+  const TextbookCase c = GetParam();
+  const std::string path = kSourceDir + "/models/textbook/" + c.file;
+  ASSERT_TRUE(fs::exists(path)) << path;
+  try {
+    const mbsgen::Model model = mbsgen::read_model_file(path);
+    EXPECT_EQ(model.coordinates().size(), c.coordinates);
+    EXPECT_EQ(model.bodies().size(), c.bodies);
+    EXPECT_NO_THROW(model.validate());
+  } catch (const ModelError& e) {
+    FAIL() << e.what();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Models, TextbookModel,
+    testing::Values(TextbookCase{"simple_pendulum.yaml", 1, 1},
+                    TextbookCase{"physical_pendulum.yaml", 1, 1},
+                    TextbookCase{"double_pendulum.yaml", 2, 2},
+                    TextbookCase{"double_pendulum_rods.yaml", 2, 2},
+                    TextbookCase{"spring_chain_fixed_fixed.yaml", 5, 5},
+                    TextbookCase{"spring_chain_fixed_free.yaml", 5, 5},
+                    TextbookCase{"spring_chain_free_free.yaml", 5, 5},
+                    TextbookCase{"spherical_pendulum_conical.yaml", 2, 1},
+                    TextbookCase{"rotor_disk.yaml", 3, 2},
+                    TextbookCase{"jeffcott_rotor.yaml", 2, 1},
+                    TextbookCase{"sleeping_top.yaml", 3, 1},
+                    TextbookCase{"ziegler_column.yaml", 2, 2},
+                    TextbookCase{"chain3_sympy.yaml", 3, 3}),
+    [](const testing::TestParamInfo<TextbookCase>& param_info) {
+      std::string name = param_info.param.file;
+      return name.substr(0, name.find('.'));
+    });
+
+TEST(TextbookModels, EveryFileIsListed) {
+  std::size_t n = 0;
+  for (const auto& entry : fs::directory_iterator(kSourceDir + "/models/textbook"))
+    if (entry.path().extension() == ".yaml") ++n;
+  EXPECT_EQ(n, 13u) << "a model file was added or removed: update the list of TextbookModel";
+}
+
+TEST(DoublePendulum, ContentsAsWritten) {
+  const mbsgen::Model m = mbsgen::read_model_file(kSourceDir + "/models/textbook/double_pendulum.yaml");
+  EXPECT_EQ(m.name(), "double_pendulum");
+  ASSERT_EQ(m.parameters().size(), 5u);
+  EXPECT_EQ(m.parameters()[4].name, "g");
+  EXPECT_EQ(m.parameters()[4].value, 9.81);
+  EXPECT_EQ(m.parameters()[4].unit, "m/s^2");
+  EXPECT_EQ(m.parameters()[0].source, "closed-forms.md §2, equal masses");
+  ASSERT_EQ(m.coordinates().size(), 2u);
+  EXPECT_EQ(m.coordinates()[1].name, "phi2");
+  EXPECT_EQ(m.coordinates()[1].unit, "rad");
+  ASSERT_EQ(m.bodies().size(), 2u);
+  const mbsgen::Body& rod2 = m.bodies()[1];
+  EXPECT_EQ(rod2.parent, "rod1");
+  ASSERT_EQ(rod2.rotations.size(), 1u);
+  EXPECT_EQ(rod2.rotations[0].axis, mbsgen::Axis::z);
+  EXPECT_TRUE(same(rod2.rotations[0].angle, m.symbol("phi2") - m.symbol("phi1")));
+  EXPECT_TRUE(same(rod2.translation[1], -m.symbol("l1")));
+  EXPECT_TRUE(same(rod2.com[1], -m.symbol("l2")));
+  EXPECT_TRUE(same(rod2.mass, m.symbol("m2")));
+  EXPECT_EQ(m.marker("tip").body, "rod2");
+  EXPECT_EQ(m.marker("pivot").body, mbsgen::kWorld);
+  ASSERT_EQ(m.gravity().size(), 1u);
+  EXPECT_EQ(m.gravity()[0].name, "gravity1");
+  EXPECT_TRUE(same(m.gravity()[0].g[1], -m.symbol("g")));
+  ASSERT_EQ(m.applied_forces().size(), 1u);
+  EXPECT_EQ(m.applied_forces()[0].frame, mbsgen::ForceFrame::world);
+  EXPECT_TRUE(same(m.applied_forces()[0].force[0], m.symbol("F")));
+  ASSERT_EQ(m.outputs().size(), 4u);
+  EXPECT_EQ(m.outputs()[0].kind, mbsgen::OutputKind::position);
+  EXPECT_EQ(m.outputs()[1].kind, mbsgen::OutputKind::velocity);
+  EXPECT_EQ(m.outputs()[2].kind, mbsgen::OutputKind::coordinate);
+  EXPECT_EQ(m.outputs()[3].kind, mbsgen::OutputKind::expression);
+  EXPECT_EQ(m.operating_point().kind, mbsgen::OperatingPoint::Kind::given);
+  // The body's location is the start of its map in the file.
+  EXPECT_EQ(rod2.where.line, 35);
+  EXPECT_EQ(rod2.where.column, 5);
+}
+
+TEST(SphericalPendulum, OperatingPointIsAnExactExpression) {
+  const mbsgen::Model m =
+      mbsgen::read_model_file(kSourceDir + "/models/textbook/spherical_pendulum_conical.yaml");
+  const auto& op = m.operating_point();
+  EXPECT_TRUE(same(op.position.at("theta"), GiNaC::Pi / 6));
+  const GiNaC::ex rate = op.velocity.at("phi");
+  const GiNaC::ex value = GiNaC::evalf(rate.subs(GiNaC::lst{m.symbol("g") == GiNaC::numeric(981, 100),
+                                                           m.symbol("L") == 1}));
+  ASSERT_TRUE(GiNaC::is_a<GiNaC::numeric>(value));
+  // closed-forms.md §5: phi'0 = 3.36565183604907 rad/s (15 digits given there).
+  EXPECT_NEAR(GiNaC::ex_to<GiNaC::numeric>(value).to_double(), 3.36565183604907, 1e-14);
+}
+
+TEST(ChainSympy, DecimalValuesAreExactInExpressionsAndRoundedAsParameters) {
+  const mbsgen::Model m = mbsgen::read_model_file(kSourceDir + "/models/textbook/chain3_sympy.yaml");
+  EXPECT_EQ(m.parameters()[1].value, 1.5);
+  EXPECT_EQ(m.parameters()[9].name, "c1");
+  EXPECT_EQ(m.parameters()[9].value, 0.1);  // the double nearest to 1/10
+  ASSERT_EQ(m.generalized_forces().size(), 3u);
+  EXPECT_TRUE(same(m.generalized_forces()[0].value,
+                   -m.symbol("k1") * m.symbol("q1") - m.symbol("c1") * m.symbol("q1_dot")));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad models: the first line of each file is `# expect: LINE:COL: error: MESSAGE`, where
+// `{file}` stands for the file's path.
+
+std::vector<std::string> bad_model_files() {
+  std::vector<std::string> files;
+  const fs::path dir = fs::path(kSourceDir) / "tests" / "data" / "bad_models";
+  if (fs::exists(dir))
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (entry.path().extension() == ".yaml") files.push_back(entry.path().filename().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+class BadModel : public testing::TestWithParam<std::string> {};
+
+TEST_P(BadModel, FailsWithTheAnnouncedMessage) {
+  const std::string path = kSourceDir + "/tests/data/bad_models/" + GetParam();
+  std::ifstream in(path);
+  std::string first;
+  std::getline(in, first);
+  const std::string prefix = "# expect: ";
+  ASSERT_EQ(first.rfind(prefix, 0), 0u) << path << ": the first line must be '" << prefix << "…'";
+  std::string expected = first.substr(prefix.size());
+  for (std::size_t at; (at = expected.find("{file}")) != std::string::npos;)
+    expected.replace(at, 6, path);
+  EXPECT_EQ(error_of_file(path), path + ":" + expected);
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, BadModel, testing::ValuesIn(bad_model_files()),
+                         [](const testing::TestParamInfo<std::string>& param_info) {
+                           return param_info.param.substr(0, param_info.param.find('.'));
+                         });
+
+TEST(BadModels, AreThere) { EXPECT_GE(bad_model_files().size(), 15u); }
+
+// ---------------------------------------------------------------------------------------------
+// Expressions
+
+class Expressions : public testing::Test {
+ protected:
+  Expressions() : model("m") {
+    model.add_parameter("l", 1.0);
+    model.add_coordinate("phi");
+  }
+  GiNaC::ex parse(const std::string& text) { return mbsgen::detail::parse_expression(model, text); }
+  mbsgen::Model model;
+};
+
+TEST_F(Expressions, DecimalLiteralsAreExactRationals) {
+  EXPECT_TRUE(same(parse("0.5"), GiNaC::numeric(1, 2)));
+  EXPECT_TRUE(same(parse("1e-6"), GiNaC::numeric(1, 1000000)));
+  EXPECT_TRUE(same(parse("2.5E3"), GiNaC::numeric(2500)));
+  EXPECT_TRUE(same(parse("1.25e-1"), GiNaC::numeric(1, 8)));
+  EXPECT_TRUE(same(parse(".5"), GiNaC::numeric(1, 2)));
+  EXPECT_TRUE(same(parse("9.81"), GiNaC::numeric(981, 100)));
+  EXPECT_TRUE(same(parse("0.1 + 0.2"), GiNaC::numeric(3, 10)));
+  for (const char* text : {"0.5", "1e-6", "9.81", "0.1 + 0.2"}) {
+    const GiNaC::ex e = parse(text);
+    ASSERT_TRUE(GiNaC::is_a<GiNaC::numeric>(e)) << text;
+    EXPECT_TRUE(GiNaC::ex_to<GiNaC::numeric>(e).is_rational()) << text;
+  }
+  EXPECT_TRUE(same(parse("2^0.5"), GiNaC::sqrt(GiNaC::ex(2))));
+}
+
+TEST_F(Expressions, SymbolsFunctionsAndPrecedence) {
+  const GiNaC::ex l = model.symbol("l"), phi = model.symbol("phi"), rate = model.symbol("phi_dot");
+  EXPECT_TRUE(same(parse("-l*sin(phi)^2 + phi_dot/2"),
+                   -l * GiNaC::pow(GiNaC::sin(phi), 2) + rate / 2));
+  EXPECT_TRUE(same(parse("atan2(l, phi)"), GiNaC::atan2(l, phi)));
+  EXPECT_TRUE(same(parse("Pi/6"), GiNaC::Pi / 6));
+  EXPECT_TRUE(same(parse("--l"), l));
+}
+
+TEST_F(Expressions, ErrorsPointAtTheOffendingCharacter) {
+  struct Case {
+    const char* text;
+    std::size_t offset;
+    const char* message;
+  };
+  for (const Case& c : {Case{"l + lenght", 4, "unknown symbol 'lenght'"},
+                        Case{"2 l", 2, "expected an operator before 'l' (multiplication is written '*')"},
+                        Case{"l +", 3, "unexpected end of expression"},
+                        Case{"", 0, "empty expression"},
+                        Case{"sin(phi", 7, "expected ',' or ')' in the arguments of 'sin'"},
+                        Case{"phi)", 3, "unmatched ')'"},
+                        Case{"atan2(phi)", 0, "function 'atan2' takes 2 arguments, got 1"},
+                        Case{"zeta(phi)", 0, "unknown function 'zeta'"},
+                        Case{"l @ 2", 2, "unexpected character '@' in an expression"},
+                        Case{"1.2.3", 0, "malformed number '1.2.3'"},
+                        Case{"3*I", 2, "the imaginary unit 'I' is not allowed in a model"}}) {
+    try {
+      parse(c.text);
+      ADD_FAILURE() << "no error for '" << c.text << "'";
+    } catch (const mbsgen::detail::ExpressionError& e) {
+      EXPECT_EQ(e.offset(), c.offset) << c.text;
+      EXPECT_EQ(std::string(e.what()), c.message) << c.text;
+    }
+  }
+}
+
+TEST(EditDistance, CountsTranspositionsAsOne) {
+  EXPECT_EQ(mbsgen::detail::edit_distance("lenght", "length"), 1u);
+  EXPECT_EQ(mbsgen::detail::edit_distance("kitten", "sitting"), 3u);
+  EXPECT_EQ(mbsgen::detail::edit_distance("", "abc"), 3u);
+  EXPECT_EQ(mbsgen::detail::edit_distance("same", "same"), 0u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Defaults and conversions
+
+const char* const kBlock = R"(model: block
+parameters: {k: 100, m: {value: 2, unit: kg}}
+coordinates: [x]
+bodies:
+  - {name: block, translation: [x, 0, 0], mass: m, markers: [{name: p}]}
+markers: [{name: wall}]
+)";
+
+TEST(Defaults, ForceNamesAreTypeAndIndexAndUnique) {
+  const mbsgen::Model m = mbsgen::read_model_string(std::string(kBlock) + R"(forces:
+  - {type: spring, between: [wall, p], stiffness: k}
+  - {type: spring, between: [wall, p], stiffness: k, name: spring1}
+  - {type: damper, between: [wall, p], damping: 1}
+  - {type: generalized, coordinate: x, value: -x_dot}
+)",
+                                                    "block.yaml");
+  ASSERT_EQ(m.springs().size(), 2u);
+  EXPECT_EQ(m.springs()[0].name, "spring2");
+  EXPECT_EQ(m.springs()[1].name, "spring1");
+  EXPECT_TRUE(m.springs()[0].rest_length.is_zero());
+  EXPECT_EQ(m.dampers()[0].name, "damper1");
+  EXPECT_EQ(m.generalized_forces()[0].name, "generalized1");
+  EXPECT_EQ(m.parameters()[1].unit, "kg");
+  EXPECT_EQ(m.parameters()[1].value, 2.0);
+  EXPECT_EQ(m.bodies()[0].parent, mbsgen::kWorld);
+  EXPECT_EQ(m.operating_point().kind, mbsgen::OperatingPoint::Kind::given);
+  EXPECT_TRUE(m.operating_point().position.empty());
+}
+
+TEST(Defaults, InertiaMapIsSymmetricAndMarkerRotationIsAMatrix) {
+  const mbsgen::Model m = mbsgen::read_model_string(R"(model: gyro
+parameters: {a: 1, b: 2, c: 3, d: 0.5}
+coordinates: [phi]
+bodies:
+  - name: disk
+    rotation: [{z: phi}]
+    mass: 1
+    inertia: {xx: a, yy: b, zz: c, xy: d}
+    markers:
+      - {name: turned, position: [1, 0, 0], rotation: [{z: Pi/2}]}
+  - name: plate
+    parent: disk
+    rotation_matrix: [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+    mass: 1
+)",
+                                                    "gyro.yaml");
+  const mbsgen::Body& disk = m.bodies()[0];
+  EXPECT_TRUE(same(disk.inertia[0][1], m.symbol("d")));
+  EXPECT_TRUE(same(disk.inertia[1][0], m.symbol("d")));
+  EXPECT_TRUE(disk.inertia[0][2].is_zero());
+  const mbsgen::Mat3& r = m.marker("turned").rotation;
+  const int expected[3][3] = {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_TRUE(same(r[i][j], expected[i][j])) << i << ',' << j << ": " << r[i][j];
+      EXPECT_TRUE(same((*m.bodies()[1].rotation_matrix)[i][j], expected[i][j]));
+    }
+}
+
+TEST(Errors, UnreadableFile) {
+  const std::string path = kSourceDir + "/tests/data/no_such_model.yaml";
+  EXPECT_EQ(error_of_file(path), path + ": error: cannot open the model file");
+}
+
+TEST(Errors, FileNameOfAStringAndColumnsInQuotedScalars) {
+  EXPECT_EQ(error_of_string(std::string(kBlock) + "forces:\n  - {type: gravity, g: ['0', \"-gg\", 0]}\n"),
+            "test.yaml:8:32: error: unknown symbol 'gg'");
+  EXPECT_EQ(error_of_string(std::string(kBlock) + "forces:\n  - {type: gravity, g: [0, 0]}\n"),
+            "test.yaml:8:24: error: gravity needs 3 components, got 2");
+}
+
+TEST(Errors, ExpressionWithEscapesIsLocatedAtTheScalar) {
+  // An escape sequence: columns inside the scalar are unknown, so the scalar's own column is used.
+  EXPECT_EQ(error_of_string(std::string(kBlock) +
+                            "forces:\n  - {type: gravity, g: [0, \"\\x2dgg\", 0]}\n"),
+            "test.yaml:8:28: error: unknown symbol 'gg'");
+}
+
+TEST(Errors, ApplicationSpecificKeysAreRejectedPerType) {
+  EXPECT_EQ(error_of_string(std::string(kBlock) +
+                            "forces:\n  - {type: gravity, g: [0, 0, 0], stiffness: k}\n"),
+            "test.yaml:8:35: error: unknown key 'stiffness' in a gravity force (allowed: type, "
+            "name, g)");
+  EXPECT_EQ(error_of_string(std::string(kBlock) +
+                            "outputs:\n  - {name: o, type: coordinate, coordinate: x, marker: p}\n"),
+            "test.yaml:8:48: error: unknown key 'marker' in a coordinate output (allowed: name, "
+            "type, unit, coordinate)");
+}
+
+}  // namespace
