@@ -1,0 +1,132 @@
+// Frequency response of  M ÿ + Q ẏ + K y = B u,  z = C_y y + C_v ẏ  (seed eqs. 3.18-3.23,
+// DESIGN.md §2): for u_j = e_j cos(Ωt − φ_j) the stationary output is z = Re(ẑ e^{iΩt}) with
+//     (K − Ω²M + iΩQ) ŷ = b_j,   ẑ = (C_y + iΩ C_v) ŷ      (b_j: column j of B, per unit input).
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <complex>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbsgen/runtime/linear_model.hpp"
+
+namespace mbsgen {
+
+/// How FrequencyResponse solves for each frequency.
+enum class FrfMethod {
+  automatic,   ///< banded for narrow-band models, hessenberg for many frequencies, else direct
+  direct,      ///< complex LU (zgetrf) of K − Ω²M + iΩQ per frequency, O(f³) each: the reference
+  banded,      ///< complex band LU (zgbtrf) of the same matrix, O(f·b²) each (chains, FE models)
+  hessenberg,  ///< one-time Hessenberg(-triangular) reduction, then O(f²) per frequency (Laub 1981)
+  modal,       ///< superposition of the modes with static correction (needs M nonsingular)
+  real         ///< DESIGN.md's corrected real formulation (Ω²E + A²)g = −A b, −Ω b (comparison)
+};
+
+/// "automatic", "direct", "banded", "hessenberg", "modal", "real".
+const char* to_string(FrfMethod method);
+/// Inverse of to_string (also accepts "auto"); throws mbsgen::Error for an unknown name.
+FrfMethod parse_frf_method(const std::string& name);
+
+/// What to do at (or numerically at) a pole of an undamped system.
+enum class PoleHandling {
+  flag,  ///< mark the point FrfFlag::pole and set its response to NaN
+  raise  ///< throw SingularSystemError naming the frequency
+};
+
+/// Per-frequency status.
+enum class FrfFlag : unsigned char {
+  ok,               ///< rcond ≥ FrfOptions::ill_conditioned_rcond
+  ill_conditioned,  ///< pole_rcond < rcond < ill_conditioned_rcond: value kept, few digits
+  pole              ///< exactly singular or rcond ≤ pole_rcond: no correct digits; value NaN
+};
+/// "ok", "ill_conditioned", "pole".
+const char* to_string(FrfFlag flag);
+
+/// Options of FrequencyResponse.
+struct FrfOptions {
+  FrfMethod method = FrfMethod::automatic;
+  PoleHandling on_pole = PoleHandling::flag;
+  /// Below this reciprocal condition number a point is flagged ill_conditioned. The forward
+  /// error bound of a backward-stable solve is about f·u/rcond, so 1e-8 means "fewer than about
+  /// 7 correct digits may remain".
+  double ill_conditioned_rcond = 1e-8;
+  /// At or below this rcond a point is a pole; 0 means the default f·u, where the error bound
+  /// f·u/rcond reaches 1 (no correct digit).
+  double pole_rcond = 0.0;
+  /// modal: keep only the k lowest (by |λ|) eigenvalue pairs; 0 keeps all 2f eigenvalues.
+  Eigen::Index modal_modes = 0;
+  /// modal with truncation: add the static (residual) correction K⁻¹b − Σ_kept (needs K regular).
+  bool static_correction = true;
+  /// modal: refuse (IllConditionedError) when the 1-norm condition estimate of the normalized
+  /// eigenvector matrix of the linearization exceeds this, unless modal_allow_ill_conditioned.
+  double modal_max_condition = 1e8;
+  bool modal_allow_ill_conditioned = false;  ///< then only a warning is recorded
+  /// hessenberg: use the standard form A = [[0, E], [−M⁻¹K, −M⁻¹Q]] (via an LU of M, never
+  /// M⁻¹ itself; dgebal + dgehrd, blocked and fast) when rcond₁(M) ≥ this; otherwise the
+  /// pencil (diag(E, M), [[0, E], [−K, −Q]]) (dggbal + dgghrd).
+  double hessenberg_mass_rcond = 1e-6;
+};
+
+/// Frequency response for one input column and selected output rows, shaped like an Eigen
+/// decomposition. The model must outlive the object. Per-method setup (factorizations,
+/// reductions, modes) happens once, on the first compute() with that method; the loop over
+/// frequencies does not allocate.
+///
+/// Every frequency carries a reciprocal condition estimate rcond (1-norm, Higham's estimator as
+/// in LAPACK xGECON) of the matrix actually solved: K − Ω²M + iΩQ (direct, banded), the reduced
+/// Hessenberg matrix iΩT − H of the balanced first-order pencil (hessenberg), Ω²E + A² (real);
+/// for modal a spectral estimate min_k |iΩ − λ_k|/max(|λ_k|,Ω) divided by the eigenvector
+/// condition. Amplitude |ẑ| and phase lag Ψ = −arg ẑ = atan2(−Im ẑ, Re ẑ), so that
+/// z(t) = |ẑ| cos(Ωt − Ψ) (eqs. 3.21-3.23 with the quadrant kept).
+class FrequencyResponse {
+ public:
+  explicit FrequencyResponse(const LinearModel& model, FrfOptions options = {});
+  ~FrequencyResponse();
+  FrequencyResponse(const FrequencyResponse&) = delete;
+  FrequencyResponse& operator=(const FrequencyResponse&) = delete;
+
+  /// Computes ẑ(Ω) for the angular frequencies omega (rad/s, any order, ≥ 0), input column
+  /// `input` (0-based) of B and the output rows `outputs` (0-based rows of C_y, C_v; empty means
+  /// all). Throws DimensionError for bad indices, SingularSystemError at a pole when
+  /// on_pole == raise, IllConditionedError/SingularSystemError when modal cannot be used.
+  FrequencyResponse& compute(const Eigen::VectorXd& omega, Eigen::Index input,
+                             const std::vector<Eigen::Index>& outputs = {});
+
+  Eigen::ComputationInfo info() const { return info_; }
+  /// The method used (never automatic after compute()).
+  FrfMethod method() const { return used_; }
+  /// p×F matrix: row r is output outputs[r], column k is frequency omega[k] (output unit per
+  /// input unit).
+  const Eigen::MatrixXcd& response() const { return response_; }
+  /// F reciprocal condition estimates (see class comment).
+  const Eigen::VectorXd& rcond() const { return rcond_; }
+  /// F flags.
+  const std::vector<FrfFlag>& flags() const { return flags_; }
+  /// Warnings recorded by the last compute() (e.g. modal without static correction).
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+  struct Impl;
+
+ private:
+  const LinearModel& model_;
+  FrfOptions options_;
+  std::unique_ptr<Impl> impl_;
+  Eigen::ComputationInfo info_ = Eigen::InvalidInput;
+  FrfMethod used_ = FrfMethod::automatic;
+  Eigen::MatrixXcd response_;
+  Eigen::VectorXd rcond_;
+  std::vector<FrfFlag> flags_;
+  std::vector<std::string> warnings_;
+};
+
+/// Amplitude |g| (eq. 3.22).
+inline double amplitude(std::complex<double> g) { return std::abs(g); }
+/// Phase lag Ψ = −arg g = atan2(−Im g, Re g) in radians, in (−π, π] (eq. 3.23 with atan2).
+inline double phase_lag(std::complex<double> g) {
+  const double p = std::atan2(-g.imag(), g.real());
+  return p <= -3.141592653589793 ? 3.141592653589793 : p + 0.0;  // (−π, π], no −0
+}
+
+}  // namespace mbsgen

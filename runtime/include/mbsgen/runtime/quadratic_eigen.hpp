@@ -1,0 +1,136 @@
+// Modes of  M ÿ + Q ẏ + K y = 0: the quadratic eigenvalue problem (λ²M + λQ + K) x = 0
+// (seed eqs. 3.12-3.17).
+#pragma once
+
+#include <Eigen/Core>
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "mbsgen/runtime/linear_model.hpp"
+
+namespace mbsgen {
+
+/// How an eigenvalue was classified.
+enum class EigenvalueKind {
+  finite,   ///< ordinary eigenvalue
+  zero,     ///< λ = 0 (rigid-body mode; K numerically singular)
+  infinite  ///< λ = ∞ (massless coordinate; M numerically singular)
+};
+
+/// "finite", "zero" or "infinite".
+const char* to_string(EigenvalueKind kind);
+
+/// One eigenpair of λ²M + λQ + K.
+struct Mode {
+  /// Reported eigenvalue λ (1/s): exactly 0 for kind zero, +∞ (real part) for kind infinite.
+  std::complex<double> lambda;
+  /// The computed homogeneous pair (α, β) with λ = α/β, unscaled, normalized |α|²+β² = 1, β ≥ 0.
+  /// Kept as computed, also for zero and infinite eigenvalues.
+  std::complex<double> alpha;
+  double beta = 0.0;
+  EigenvalueKind kind = EigenvalueKind::finite;
+  double natural_frequency_hz = 0.0;  ///< |λ|/2π (Hz); 0 for zero, +∞ for infinite
+  double damped_frequency_hz = 0.0;   ///< Im λ/2π (Hz)
+  /// −Re λ/|λ| (dimensionless); NaN for zero eigenvalues (undefined), 0 for infinite ones.
+  double damping_ratio = 0.0;
+  /// Right eigenvector x (f), normalized to ‖x‖₂ = 1 with its largest-modulus entry real positive.
+  Eigen::VectorXcd shape;
+  /// Left eigenvector y (f), yᴴ(λ²M + λQ + K) = 0, same normalization.
+  Eigen::VectorXcd left_shape;
+  /// Normwise backward error (Tisseur 2000, eq. 2.3, homogeneous form):
+  /// ‖(α²M + αβQ + β²K)x‖ / ((|α|²‖M‖ + |α|β‖Q‖ + β²‖K‖)‖x‖), with ‖·‖₂ lower estimates of the
+  /// coefficient norms (so the value errs on the large side).
+  double backward_error = 0.0;
+  /// Relative condition number of λ (Tisseur 2000, Thm. 5):
+  /// (|λ|²‖M‖ + |λ|‖Q‖ + ‖K‖)‖x‖‖y‖ / (|λ| |yᴴ(2λM + Q)x|); +∞ for zero and infinite kinds.
+  double condition = 0.0;
+  /// Homogeneous (chordal) condition number of (α, β) (Dedieu & Tisseur 2003), finite also for
+  /// zero and infinite eigenvalues.
+  double condition_homogeneous = 0.0;
+};
+
+/// Options of QuadraticEigenSolver.
+struct QuadraticEigenOptions {
+  enum class Scaling {
+    automatic,           ///< Fan-Lin-Van Dooren if τ = ‖Q‖/√(‖M‖‖K‖) < 10, else tropical
+    none,                ///< no scaling
+    fan_lin_van_dooren,  ///< λ = γμ, γ = √(‖K‖/‖M‖), δ = 2/(‖K‖ + γ‖Q‖)  (Fan, Lin & Van Dooren 2004)
+    tropical             ///< two QZ runs with the tropical roots (Gaubert & Sharify; quadeig)
+  };
+  Scaling scaling = Scaling::automatic;
+  bool balance = true;               ///< LAPACK dggevx balancing (permute and scale), 'B'
+  bool symmetric_fast_path = true;   ///< dsygvd when Q = 0, M = Mᵀ > 0, K = Kᵀ
+  /// Rank tolerance: a pivot |R_ii| ≤ rank_tolerance·|R_00| of the column-pivoted QR of M (or K)
+  /// counts as zero. 0 means the default f·u (u = 2⁻⁵³).
+  double rank_tolerance = 0.0;
+  /// Classification tolerance: when M has numerical nullity d, up to 2d eigenvalues with
+  /// |λ| ≥ γ/classification_tolerance are reported infinite; when K has nullity d, up to 2d with
+  /// |λ| ≤ γ·classification_tolerance are reported zero (γ = √(‖K‖/‖M‖)). The default 1e-6
+  /// separates the O(√u) perturbation of a 2×2 Jordan block at 0 or ∞ from physical modes.
+  double classification_tolerance = 1e-6;
+  /// Report each complex-conjugate pair once (the member with Im λ > 0), and a double zero
+  /// eigenvalue of a rigid-body mode once.
+  bool one_per_conjugate_pair = false;
+};
+
+/// Solver for all 2f eigenpairs of λ²M + λQ + K, shaped like an Eigen decomposition.
+///
+/// General path: the first companion linearization
+///     μ [[E, 0], [0, M̃]] − [[0, E], [−K̃, −Q̃]],   z = [x; μx],
+/// of the scaled problem M̃ = γ²δM, Q̃ = γδQ, K̃ = δK, λ = γμ, solved by LAPACK dggevx with
+/// balancing; x is taken from the block of z that gives the smaller backward error (as in
+/// quadeig, Hammarling, Munro & Tisseur 2013). The symmetric undamped fast path uses dsygvd
+/// (Cholesky of M inside LAPACK; M⁻¹ is never formed). Cost: O(f³), about 10·(2f)³ flops for QZ.
+class QuadraticEigenSolver {
+ public:
+  /// Preallocates for f coordinates.
+  explicit QuadraticEigenSolver(Eigen::Index f = 0, QuadraticEigenOptions options = {});
+
+  /// Computes the eigenpairs of the model's λ²M + λQ + K. Throws LapackError if QZ fails.
+  QuadraticEigenSolver& compute(const LinearModel& model);
+  /// Same for raw f×f matrices (validated as LinearModel does).
+  QuadraticEigenSolver& compute(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
+                                const Eigen::MatrixXd& K);
+
+  /// Eigen::Success after a successful compute().
+  Eigen::ComputationInfo info() const { return info_; }
+  /// Eigenpairs sorted: zero kind first, then finite by increasing |λ| (Im λ ≥ 0 first within a
+  /// conjugate pair), then infinite.
+  const std::vector<Mode>& modes() const { return modes_; }
+
+  Eigen::Index rank_M() const { return rank_M_; }  ///< numerical rank of M
+  Eigen::Index rank_K() const { return rank_K_; }  ///< numerical rank of K
+  double tau() const { return tau_; }              ///< ‖Q‖/√(‖M‖‖K‖) (Frobenius norms)
+  double gamma() const { return gamma_; }          ///< eigenvalue scaling γ (1/s)
+  /// "symmetric", "fan_lin_van_dooren", "tropical" or "none": what compute() used.
+  const std::string& method() const { return method_; }
+  /// Largest backward error over all eigenpairs.
+  double max_backward_error() const;
+
+ private:
+  void compute_symmetric(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K, bool& ok);
+  void compute_general(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
+                       const Eigen::MatrixXd& K);
+  void finish(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& K);
+
+  QuadraticEigenOptions options_;
+  Eigen::ComputationInfo info_ = Eigen::InvalidInput;
+  std::vector<Mode> modes_;
+  Eigen::Index rank_M_ = 0, rank_K_ = 0;
+  double tau_ = 0.0, gamma_ = 1.0;
+  double norm_M_ = 0.0, norm_Q_ = 0.0, norm_K_ = 0.0;  // ‖·‖₂ lower estimates
+  std::string method_;
+  // Workspaces of the linearization (2f×2f) reused across compute() calls.
+  Eigen::MatrixXd A_, B_, VL_, VR_;
+  Eigen::VectorXd alphar_, alphai_, beta_;
+};
+
+/// Backward error of an approximate eigenpair (α, β, x) of λ²M + λQ + K in the homogeneous form
+/// of Tisseur (2000) with given coefficient norms (any consistent norm; the solver uses ‖·‖₂).
+double quadratic_backward_error(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
+                                const Eigen::MatrixXd& K, std::complex<double> alpha, double beta,
+                                const Eigen::VectorXcd& x, double norm_M, double norm_Q,
+                                double norm_K);
+
+}  // namespace mbsgen

@@ -1,0 +1,709 @@
+#include "mbsgen/runtime/frequency_response.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "lapack.hpp"
+#include "mbsgen/runtime/quadratic_eigen.hpp"
+
+namespace mbsgen {
+
+using cd = std::complex<double>;
+using Eigen::Index;
+using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using RowMatrixXcd = Eigen::Matrix<cd, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+namespace {
+constexpr double kU = std::numeric_limits<double>::epsilon() / 2;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+
+/// Column j of a permuted-diagonal matrix X has its single nonzero val[j] in row row[j];
+/// X is obtained by applying LAPACK's xGEBAK/xGGBAK to the identity.
+struct PermutedDiagonal {
+  std::vector<Index> row;
+  Eigen::VectorXd val;
+  void from_dense(const Eigen::MatrixXd& X) {
+    const Index n = X.cols();
+    row.assign(static_cast<std::size_t>(n), 0);
+    val.resize(n);
+    for (Index j = 0; j < n; ++j) {
+      Index i = 0;
+      X.col(j).cwiseAbs().maxCoeff(&i);
+      row[static_cast<std::size_t>(j)] = i;
+      val[j] = X(i, j);
+    }
+  }
+  /// (Xᵀ v)_j = val_j · v_{row_j}
+  template <class V>
+  Eigen::VectorXd transpose_times(const V& v) const {
+    Eigen::VectorXd out(val.size());
+    for (Index j = 0; j < val.size(); ++j) out[j] = val[j] * v[row[static_cast<std::size_t>(j)]];
+    return out;
+  }
+};
+
+/// LU with adjacent-row partial pivoting of an upper Hessenberg W (row-major, order N), O(N²),
+/// with solves for W and Wᴴ and a 1-norm condition estimate. Workspaces allocated once.
+struct HessenbergLU {
+  RowMatrixXcd W;
+  Eigen::VectorXcd l;
+  std::vector<unsigned char> swapped;
+  Eigen::VectorXcd x, xi;
+  Index N = 0;
+  void resize(Index n) {
+    N = n;
+    W.resize(n, n);
+    l.resize(n);
+    swapped.assign(static_cast<std::size_t>(n), 0);
+    x.resize(n);
+    xi.resize(n);
+  }
+  /// Factorizes W in place; returns false if an exact zero pivot occurs.
+  bool factorize() {
+    for (Index k = 0; k + 1 < N; ++k) {
+      const Index len = N - k;
+      cd* rk = &W(k, k);
+      cd* rk1 = &W(k + 1, k);
+      const bool sw = std::abs(*rk1) > std::abs(*rk);
+      swapped[static_cast<std::size_t>(k)] = sw;
+      if (sw)
+        for (Index j = 0; j < len; ++j) std::swap(rk[j], rk1[j]);
+      if (*rk == cd(0.0)) return false;
+      const cd lk = *rk1 / *rk;
+      l[k] = lk;
+      rk1[0] = 0.0;
+      for (Index j = 1; j < len; ++j) rk1[j] -= lk * rk[j];
+    }
+    return W(N - 1, N - 1) != cd(0.0);
+  }
+  void solve(Eigen::VectorXcd& r) const {
+    for (Index k = 0; k + 1 < N; ++k) {
+      if (swapped[static_cast<std::size_t>(k)]) std::swap(r[k], r[k + 1]);
+      r[k + 1] -= l[k] * r[k];
+    }
+    for (Index i = N - 1; i >= 0; --i) {
+      cd s = r[i];
+      const cd* wi = &W(i, 0);
+      for (Index j = i + 1; j < N; ++j) s -= wi[j] * r[j];
+      r[i] = s / wi[i];
+    }
+  }
+  void solve_adjoint(Eigen::VectorXcd& r) const {
+    for (Index j = 0; j < N; ++j) {  // Uᴴ v = r, column-oriented on the rows of U
+      const cd* wj = &W(j, 0);
+      r[j] /= std::conj(wj[j]);
+      const cd rj = r[j];
+      for (Index i = j + 1; i < N; ++i) r[i] -= std::conj(wj[i]) * rj;
+    }
+    for (Index k = N - 2; k >= 0; --k) {
+      r[k] -= std::conj(l[k]) * r[k + 1];
+      if (swapped[static_cast<std::size_t>(k)]) std::swap(r[k], r[k + 1]);
+    }
+  }
+  double inverse_norm1() {
+    return detail::inverse_norm1_estimate(
+        N, [this](Eigen::VectorXcd& v) { solve(v); },
+        [this](Eigen::VectorXcd& v) { solve_adjoint(v); }, x, xi);
+  }
+};
+
+std::string hz(double omega) {
+  std::ostringstream s;
+  s << omega << " rad/s (" << omega / kTwoPi << " Hz)";
+  return s.str();
+}
+
+}  // namespace
+
+const char* to_string(FrfMethod method) {
+  switch (method) {
+    case FrfMethod::automatic: return "automatic";
+    case FrfMethod::direct: return "direct";
+    case FrfMethod::banded: return "banded";
+    case FrfMethod::hessenberg: return "hessenberg";
+    case FrfMethod::modal: return "modal";
+    case FrfMethod::real: return "real";
+  }
+  return "?";
+}
+
+FrfMethod parse_frf_method(const std::string& name) {
+  if (name == "auto" || name == "automatic") return FrfMethod::automatic;
+  if (name == "direct") return FrfMethod::direct;
+  if (name == "banded") return FrfMethod::banded;
+  if (name == "hessenberg") return FrfMethod::hessenberg;
+  if (name == "modal") return FrfMethod::modal;
+  if (name == "real") return FrfMethod::real;
+  throw Error("parse_frf_method: unknown method '" + name +
+              "' (expected auto, direct, banded, hessenberg, modal, real)");
+}
+
+const char* to_string(FrfFlag flag) {
+  switch (flag) {
+    case FrfFlag::ok: return "ok";
+    case FrfFlag::ill_conditioned: return "ill_conditioned";
+    case FrfFlag::pole: return "pole";
+  }
+  return "?";
+}
+
+// ---------------------------------------------------------------------------------------------
+struct FrequencyResponse::Impl {
+  const LinearModel& model;
+  Index n;
+  // selected input/outputs for the current compute()
+  Eigen::VectorXd b;
+  Eigen::MatrixXcd Cy, Cv;  // p×n, complex copies so that products do not allocate
+  Eigen::VectorXcd z;       // p
+
+  explicit Impl(const LinearModel& m) : model(m), n(m.size()) {}
+
+  // ---- direct ----
+  bool direct_ready = false;
+  Eigen::MatrixXcd D;
+  Eigen::VectorXcd y;
+  std::vector<lapack_int> ipiv;
+  Eigen::VectorXcd zwork;
+  Eigen::VectorXd rwork;
+  void prepare_direct() {
+    if (direct_ready) return;
+    D.resize(n, n);
+    y.resize(n);
+    ipiv.resize(static_cast<std::size_t>(n));
+    zwork.resize(2 * n);
+    rwork.resize(2 * n);
+    direct_ready = true;
+  }
+  /// Returns false for an exactly singular matrix.
+  bool point_direct(double om, double& rc) {
+    const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
+    const double om2 = om * om;
+    double anorm = 0.0;
+    for (Index j = 0; j < n; ++j) {
+      double s = 0.0;
+      for (Index i = 0; i < n; ++i) {
+        const cd v(K(i, j) - om2 * M(i, j), om * Q(i, j));
+        D(i, j) = v;
+        s += std::abs(v);
+      }
+      anorm = std::max(anorm, s);
+    }
+    const lapack_int nn = detail::li(n);
+    lapack_int info = LAPACKE_zgetrf_work(LAPACK_COL_MAJOR, nn, nn, D.data(), nn, ipiv.data());
+    detail::check_lapack(info, "zgetrf", "FrequencyResponse::compute");
+    if (info > 0) {
+      rc = 0.0;
+      return false;
+    }
+    info = LAPACKE_zgecon_work(LAPACK_COL_MAJOR, '1', nn, D.data(), nn, anorm, &rc, zwork.data(),
+                               rwork.data());
+    detail::check_lapack(info, "zgecon", "FrequencyResponse::compute");
+    for (Index i = 0; i < n; ++i) y[i] = b[i];
+    info = LAPACKE_zgetrs_work(LAPACK_COL_MAJOR, 'N', nn, 1, D.data(), nn, ipiv.data(), y.data(),
+                               nn);
+    detail::check_lapack(info, "zgetrs", "FrequencyResponse::compute");
+    z.noalias() = Cy * y;
+    z.noalias() += cd(0.0, om) * (Cv * y);
+    return true;
+  }
+
+  // ---- banded ----
+  bool banded_ready = false;
+  Index kl = 0;
+  Eigen::MatrixXcd AB;  // (2kl+ku+1)×n band storage, ku = kl
+  void prepare_banded() {
+    if (banded_ready) return;
+    kl = std::max<Index>(model.bandwidth(), 0);
+    AB.resize(3 * kl + 1, n);
+    y.resize(n);
+    ipiv.resize(static_cast<std::size_t>(n));
+    zwork.resize(2 * n);
+    rwork.resize(2 * n);
+    banded_ready = true;
+  }
+  bool point_banded(double om, double& rc) {
+    const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
+    const double om2 = om * om;
+    const Index ku = kl;
+    AB.setZero();
+    double anorm = 0.0;
+    for (Index j = 0; j < n; ++j) {
+      double s = 0.0;
+      for (Index i = std::max<Index>(0, j - ku); i <= std::min(n - 1, j + kl); ++i) {
+        const cd v(K(i, j) - om2 * M(i, j), om * Q(i, j));
+        AB(kl + ku + i - j, j) = v;
+        s += std::abs(v);
+      }
+      anorm = std::max(anorm, s);
+    }
+    const lapack_int nn = detail::li(n), lkl = detail::li(kl), ld = detail::li(AB.rows());
+    lapack_int info =
+        LAPACKE_zgbtrf_work(LAPACK_COL_MAJOR, nn, nn, lkl, lkl, AB.data(), ld, ipiv.data());
+    detail::check_lapack(info, "zgbtrf", "FrequencyResponse::compute");
+    if (info > 0) {
+      rc = 0.0;
+      return false;
+    }
+    info = LAPACKE_zgbcon_work(LAPACK_COL_MAJOR, '1', nn, lkl, lkl, AB.data(), ld, ipiv.data(),
+                               anorm, &rc, zwork.data(), rwork.data());
+    detail::check_lapack(info, "zgbcon", "FrequencyResponse::compute");
+    for (Index i = 0; i < n; ++i) y[i] = b[i];
+    info = LAPACKE_zgbtrs_work(LAPACK_COL_MAJOR, 'N', nn, lkl, lkl, 1, AB.data(), ld, ipiv.data(),
+                               y.data(), nn);
+    detail::check_lapack(info, "zgbtrs", "FrequencyResponse::compute");
+    z.noalias() = Cy * y;
+    z.noalias() += cd(0.0, om) * (Cv * y);
+    return true;
+  }
+
+  // ---- hessenberg (Laub 1981; SLICOT TB05AD) ----
+  bool hess_ready = false;
+  bool hess_standard = false;
+  Index N = 0;
+  RowMatrixXd H, T;                  // reduced pencil (T unused in the standard form)
+  Eigen::MatrixXd reflectors;        // dgehrd output (standard form)
+  Eigen::VectorXd hess_tau;          // dgehrd tau
+  lapack_int hilo = 1, hihi = 1;
+  Eigen::PartialPivLU<Eigen::MatrixXd> Mlu;  // standard form: LU of M
+  Eigen::MatrixXd Qleft, Zright;     // pencil form: Qᵀ(balanced) Z, both N×N
+  Eigen::MatrixXd qr_E;              // pencil form: QR factors of the balanced E
+  Eigen::VectorXd qr_tau;
+  PermutedDiagonal Xl, Xr;           // balancing: Ã = Xlᵀ A Xr, x = Xr x̃
+  HessenbergLU hlu;
+  Eigen::VectorXcd hrhs;             // reduced right-hand side r̃ (N)
+  Eigen::MatrixXcd Chat;             // p×N reduced outputs
+  std::string hess_form;
+
+  void prepare_hessenberg(double mass_rcond) {
+    if (hess_ready) return;
+    const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
+    N = 2 * n;
+    const lapack_int NN = detail::li(N);
+    Mlu.compute(M);
+    hess_standard = Mlu.rcond() >= mass_rcond;
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(N, N);
+    A.topRightCorner(n, n).setIdentity();
+    if (hess_standard) {
+      hess_form = "standard";
+      A.bottomLeftCorner(n, n) = -Mlu.solve(K);
+      A.bottomRightCorner(n, n) = -Mlu.solve(Q);
+      Eigen::VectorXd scale(N);
+      lapack_int info = LAPACKE_dgebal(LAPACK_COL_MAJOR, 'B', NN, A.data(), NN, &hilo, &hihi,
+                                       scale.data());
+      detail::check_lapack(info, "dgebal", "FrequencyResponse (hessenberg)");
+      Eigen::MatrixXd I = Eigen::MatrixXd::Identity(N, N);
+      info = LAPACKE_dgebak(LAPACK_COL_MAJOR, 'B', 'R', NN, hilo, hihi, scale.data(), NN,
+                            I.data(), NN);
+      detail::check_lapack(info, "dgebak", "FrequencyResponse (hessenberg)");
+      Xr.from_dense(I);
+      I.setIdentity();
+      info = LAPACKE_dgebak(LAPACK_COL_MAJOR, 'B', 'L', NN, hilo, hihi, scale.data(), NN,
+                            I.data(), NN);
+      detail::check_lapack(info, "dgebak", "FrequencyResponse (hessenberg)");
+      Xl.from_dense(I);
+      hess_tau.resize(std::max<Index>(N - 1, 1));
+      info = LAPACKE_dgehrd(LAPACK_COL_MAJOR, NN, hilo, hihi, A.data(), NN, hess_tau.data());
+      detail::check_lapack(info, "dgehrd", "FrequencyResponse (hessenberg)");
+      H = A.triangularView<Eigen::Upper>();
+      for (Index i = 1; i < N; ++i) H(i, i - 1) = A(i, i - 1);
+      reflectors = std::move(A);
+    } else {
+      hess_form = "pencil";
+      A.bottomLeftCorner(n, n) = -K;
+      A.bottomRightCorner(n, n) = -Q;
+      Eigen::MatrixXd E = Eigen::MatrixXd::Zero(N, N);
+      E.topLeftCorner(n, n).setIdentity();
+      E.bottomRightCorner(n, n) = M;
+      Eigen::VectorXd lscale(N), rscale(N);
+      lapack_int info = LAPACKE_dggbal(LAPACK_COL_MAJOR, 'B', NN, A.data(), NN, E.data(), NN,
+                                       &hilo, &hihi, lscale.data(), rscale.data());
+      detail::check_lapack(info, "dggbal", "FrequencyResponse (hessenberg)");
+      Eigen::MatrixXd I = Eigen::MatrixXd::Identity(N, N);
+      info = LAPACKE_dggbak(LAPACK_COL_MAJOR, 'B', 'R', NN, hilo, hihi, lscale.data(),
+                            rscale.data(), NN, I.data(), NN);
+      detail::check_lapack(info, "dggbak", "FrequencyResponse (hessenberg)");
+      Xr.from_dense(I);
+      I.setIdentity();
+      info = LAPACKE_dggbak(LAPACK_COL_MAJOR, 'B', 'L', NN, hilo, hihi, lscale.data(),
+                            rscale.data(), NN, I.data(), NN);
+      detail::check_lapack(info, "dggbak", "FrequencyResponse (hessenberg)");
+      Xl.from_dense(I);
+      // Triangularize E by QR, apply Qᵀ to A, then Hessenberg-triangular reduction (dgghrd).
+      qr_tau.resize(N);
+      info = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, NN, NN, E.data(), NN, qr_tau.data());
+      detail::check_lapack(info, "dgeqrf", "FrequencyResponse (hessenberg)");
+      info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', NN, NN, NN, E.data(), NN, qr_tau.data(),
+                            A.data(), NN);
+      detail::check_lapack(info, "dormqr", "FrequencyResponse (hessenberg)");
+      qr_E = E;
+      Eigen::MatrixXd R = E.triangularView<Eigen::Upper>();
+      Qleft.resize(N, N);
+      Zright.resize(N, N);
+      info = LAPACKE_dgghrd(LAPACK_COL_MAJOR, 'I', 'I', NN, hilo, hihi, A.data(), NN, R.data(),
+                            NN, Qleft.data(), NN, Zright.data(), NN);
+      detail::check_lapack(info, "dgghrd", "FrequencyResponse (hessenberg)");
+      H = A;
+      for (Index j = 0; j < N; ++j)
+        for (Index i = j + 2; i < N; ++i) H(i, j) = 0.0;
+      T = R.triangularView<Eigen::Upper>();
+    }
+    hlu.resize(N);
+    hrhs.resize(N);
+    hess_ready = true;
+  }
+
+  /// Reduced right-hand side and outputs for the current input/outputs.
+  void select_hessenberg() {
+    const lapack_int NN = detail::li(N);
+    Eigen::VectorXd bx = Eigen::VectorXd::Zero(N);
+    if (hess_standard)
+      bx.tail(n) = Mlu.solve(b);
+    else
+      bx.tail(n) = b;
+    Eigen::VectorXd r = Xl.transpose_times(bx);
+    const Index p = Cy.rows();
+    Eigen::MatrixXd Cx(p, N);  // first-order outputs z = [C_y, C_v] x
+    Cx << Cy.real(), Cv.real();
+    Eigen::MatrixXd Ct(N, p);  // (C_x Xr)ᵀ
+    for (Index k = 0; k < p; ++k) Ct.col(k) = Xr.transpose_times(Cx.row(k).transpose());
+    if (hess_standard) {
+      lapack_int info =
+          LAPACKE_dormhr(LAPACK_COL_MAJOR, 'L', 'T', NN, 1, hilo, hihi, reflectors.data(), NN,
+                         hess_tau.data(), r.data(), NN);
+      detail::check_lapack(info, "dormhr", "FrequencyResponse (hessenberg)");
+      if (p > 0) {
+        info = LAPACKE_dormhr(LAPACK_COL_MAJOR, 'L', 'T', NN, detail::li(p), hilo, hihi,
+                              reflectors.data(), NN, hess_tau.data(), Ct.data(), NN);
+        detail::check_lapack(info, "dormhr", "FrequencyResponse (hessenberg)");
+      }
+    } else {
+      lapack_int info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', NN, 1, NN, qr_E.data(), NN,
+                                       qr_tau.data(), r.data(), NN);
+      detail::check_lapack(info, "dormqr", "FrequencyResponse (hessenberg)");
+      r = Qleft.transpose() * r;
+      Ct = Zright.transpose() * Ct;
+    }
+    hrhs.resize(N);
+    Chat = Ct.transpose().cast<cd>();
+    rhs_reduced = r;
+  }
+  Eigen::VectorXd rhs_reduced;
+
+  bool point_hessenberg(double om, double& rc) {
+    const cd s(0.0, om);
+    RowMatrixXcd& W = hlu.W;
+    Eigen::VectorXd& colsum = colsum_ws;
+    colsum.setZero(N);
+    for (Index i = 0; i < N; ++i) {
+      const Index j0 = i > 0 ? i - 1 : 0;
+      const double* hi = &H(i, 0);
+      cd* wi = &W(i, 0);
+      for (Index j = 0; j < j0; ++j) wi[j] = 0.0;
+      if (hess_standard) {
+        for (Index j = j0; j < N; ++j) wi[j] = -hi[j];
+        wi[i] += s;
+      } else {
+        const double* ti = &T(i, 0);
+        for (Index j = j0; j < N; ++j) wi[j] = cd(-hi[j], om * ti[j]);
+      }
+      for (Index j = j0; j < N; ++j) colsum[j] += std::abs(wi[j]);
+    }
+    const double anorm = colsum.maxCoeff();
+    if (!hlu.factorize()) {
+      rc = 0.0;
+      return false;
+    }
+    const double inv = hlu.inverse_norm1();
+    rc = (anorm > 0 && inv > 0) ? 1.0 / (anorm * inv) : 0.0;
+    for (Index i = 0; i < N; ++i) hrhs[i] = rhs_reduced[i];
+    hlu.solve(hrhs);
+    z.noalias() = Chat * hrhs;
+    return true;
+  }
+  Eigen::VectorXd colsum_ws;
+
+  // ---- modal ----
+  bool modal_ready = false;
+  std::vector<Mode> modes;
+  double eigvec_condition = 0.0;
+  Eigen::VectorXcd lam, coef;  // kept eigenvalues; y_kᴴ b / (y_kᴴ P'(λ_k) x_k)
+  Eigen::MatrixXcd CX, CVX;    // p×k: C_y x_k, C_v x_k
+  Eigen::VectorXcd zstatic_y, zstatic_v;  // C_y r0, C_v r0 (static correction)
+  Eigen::VectorXcd dk;
+  void prepare_modal(const FrfOptions& opt, std::vector<std::string>& warnings) {
+    if (!modal_ready) {
+      QuadraticEigenOptions eo;
+      QuadraticEigenSolver es(n, eo);
+      es.compute(model);
+      for (const Mode& m : es.modes())
+        if (m.kind != EigenvalueKind::finite)
+          throw SingularSystemError(
+              std::string("FrequencyResponse (modal): the model has ") + to_string(m.kind) +
+              " eigenvalues (singular " + (m.kind == EigenvalueKind::zero ? "K" : "M") +
+              "); modal superposition needs all 2f eigenvalues finite and nonzero: use direct");
+      modes = es.modes();
+      const Index nm = static_cast<Index>(modes.size());
+      Eigen::MatrixXcd V(2 * n, nm);
+      dk.resize(nm);
+      const Eigen::MatrixXcd Mc = model.M().cast<cd>(), Qc = model.Q().cast<cd>();
+      for (Index k = 0; k < nm; ++k) {
+        const Mode& m = modes[static_cast<std::size_t>(k)];
+        V.col(k) << m.shape, m.lambda * m.shape;
+        V.col(k).normalize();
+        dk[k] = m.left_shape.dot(2.0 * m.lambda * (Mc * m.shape) + Qc * m.shape);
+      }
+      const double rc = Eigen::PartialPivLU<Eigen::MatrixXcd>(V).rcond();
+      eigvec_condition = rc > 0 ? 1.0 / rc : std::numeric_limits<double>::infinity();
+      modal_ready = true;
+    }
+    if (!(eigvec_condition <= opt.modal_max_condition)) {
+      std::ostringstream s;
+      s << "FrequencyResponse (modal): eigenvector matrix condition estimate " << eigvec_condition
+        << " exceeds " << opt.modal_max_condition
+        << " (near-defective eigenvalues); the modal sum is unreliable: use direct";
+      if (!opt.modal_allow_ill_conditioned) throw IllConditionedError(s.str());
+      warnings.push_back(s.str());
+    }
+  }
+  void select_modal(const FrfOptions& opt, std::vector<std::string>& warnings) {
+    const Index nm = static_cast<Index>(modes.size());
+    Index keep = nm;
+    if (opt.modal_modes > 0 && 2 * opt.modal_modes < nm) {
+      keep = 2 * opt.modal_modes;
+      const auto& a = modes[static_cast<std::size_t>(keep - 1)].lambda;
+      const auto& c = modes[static_cast<std::size_t>(keep)].lambda;
+      if (a.imag() != 0 && c == std::conj(a)) ++keep;  // do not split a conjugate pair
+    }
+    const Index p = Cy.rows();
+    lam.resize(keep);
+    coef.resize(keep);
+    CX.resize(p, keep);
+    CVX.resize(p, keep);
+    Eigen::VectorXcd y0 = Eigen::VectorXcd::Zero(n);
+    for (Index k = 0; k < keep; ++k) {
+      const Mode& m = modes[static_cast<std::size_t>(k)];
+      lam[k] = m.lambda;
+      coef[k] = m.left_shape.dot(b.cast<cd>()) / dk[k];
+      CX.col(k) = Cy * m.shape;
+      CVX.col(k) = Cv * m.shape;
+      y0 += m.shape * (coef[k] / (-m.lambda));
+    }
+    zstatic_y = Eigen::VectorXcd::Zero(p);
+    zstatic_v = Eigen::VectorXcd::Zero(p);
+    if (keep < nm) {
+      if (!opt.static_correction) {
+        warnings.push_back("FrequencyResponse (modal): truncated without static correction");
+      } else {
+        Eigen::FullPivLU<Eigen::MatrixXd> Klu(model.K());
+        if (!Klu.isInvertible()) {
+          warnings.push_back("FrequencyResponse (modal): K singular, no static correction");
+        } else {
+          const Eigen::VectorXcd r0 = Klu.solve(b).cast<cd>() - y0;
+          zstatic_y = Cy * r0;
+          zstatic_v = Cv * r0;
+        }
+      }
+    }
+  }
+  bool point_modal(double om, double& rc) {
+    const cd s(0.0, om);
+    z = zstatic_y + s * zstatic_v;
+    double dmin = std::numeric_limits<double>::infinity();
+    for (Index k = 0; k < lam.size(); ++k) {
+      const cd d = s - lam[k];
+      dmin = std::min(dmin, std::abs(d) / std::max(std::abs(lam[k]), om));
+      if (d == cd(0.0)) {
+        rc = 0.0;
+        return false;
+      }
+      const cd w = coef[k] / d;
+      z += w * (CX.col(k) + s * CVX.col(k));
+    }
+    rc = dmin / eigvec_condition;
+    return true;
+  }
+
+  // ---- real formulation (DESIGN.md §2) ----
+  bool real_ready = false;
+  Eigen::MatrixXd A1, A2, S, G;
+  Eigen::VectorXd Ab;
+  std::vector<lapack_int> ipiv_r;
+  Eigen::VectorXd dwork;
+  std::vector<lapack_int> iwork;
+  Eigen::MatrixXcd Cxc;
+  Eigen::VectorXcd gc;
+  void prepare_real() {
+    if (real_ready) return;
+    N = 2 * n;
+    Mlu.compute(model.M());
+    if (!(Mlu.rcond() > 1e3 * kU))
+      throw SingularSystemError(
+          "FrequencyResponse (real): M is singular or nearly so (rcond " +
+          std::to_string(Mlu.rcond()) + "); the real formulation needs A = [[0,E],[-M^-1 K, "
+          "-M^-1 Q]]: use direct or hessenberg");
+    A1 = Eigen::MatrixXd::Zero(N, N);
+    A1.topRightCorner(n, n).setIdentity();
+    A1.bottomLeftCorner(n, n) = -Mlu.solve(model.K());
+    A1.bottomRightCorner(n, n) = -Mlu.solve(model.Q());
+    A2.noalias() = A1 * A1;
+    S.resize(N, N);
+    G.resize(N, 2);
+    ipiv_r.resize(static_cast<std::size_t>(N));
+    dwork.resize(4 * N);
+    iwork.resize(static_cast<std::size_t>(N));
+    gc.resize(N);
+    real_ready = true;
+  }
+  void select_real() {
+    Eigen::VectorXd bx = Eigen::VectorXd::Zero(N);
+    bx.tail(n) = Mlu.solve(b);
+    Ab = -(A1 * bx);
+    rhs_reduced = bx;
+    Cxc.resize(Cy.rows(), N);
+    Cxc << Cy, Cv;
+  }
+  bool point_real(double om, double& rc) {
+    S = A2;
+    S.diagonal().array() += om * om;
+    double anorm = 0.0;
+    for (Index j = 0; j < N; ++j) anorm = std::max(anorm, S.col(j).cwiseAbs().sum());
+    const lapack_int NN = detail::li(N);
+    lapack_int info = LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, NN, NN, S.data(), NN, ipiv_r.data());
+    detail::check_lapack(info, "dgetrf", "FrequencyResponse (real)");
+    if (info > 0) {
+      rc = 0.0;
+      return false;
+    }
+    info = LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', NN, S.data(), NN, anorm, &rc, dwork.data(),
+                               iwork.data());
+    detail::check_lapack(info, "dgecon", "FrequencyResponse (real)");
+    G.col(0) = Ab;
+    G.col(1) = -om * rhs_reduced;
+    info = LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', NN, 2, S.data(), NN, ipiv_r.data(),
+                               G.data(), NN);
+    detail::check_lapack(info, "dgetrs", "FrequencyResponse (real)");
+    gc.real() = G.col(0);
+    gc.imag() = G.col(1);
+    z.noalias() = Cxc * gc;
+    return true;
+  }
+};
+
+FrequencyResponse::FrequencyResponse(const LinearModel& model, FrfOptions options)
+    : model_(model), options_(options), impl_(std::make_unique<Impl>(model)) {}
+
+FrequencyResponse::~FrequencyResponse() = default;
+
+FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Index input,
+                                              const std::vector<Index>& outputs) {
+  info_ = Eigen::InvalidInput;
+  warnings_.clear();
+  Impl& im = *impl_;
+  const Index n = model_.size();
+  if (input < 0 || input >= model_.num_inputs()) {
+    std::ostringstream s;
+    s << "FrequencyResponse::compute: input index " << input << " out of range (B is " << n
+      << "x" << model_.num_inputs() << ")";
+    throw DimensionError(s.str());
+  }
+  std::vector<Index> rows = outputs;
+  if (rows.empty())
+    for (Index i = 0; i < model_.num_outputs(); ++i) rows.push_back(i);
+  for (Index r : rows)
+    if (r < 0 || r >= model_.num_outputs()) {
+      std::ostringstream s;
+      s << "FrequencyResponse::compute: output index " << r << " out of range (C_y is "
+        << model_.num_outputs() << "x" << n << ")";
+      throw DimensionError(s.str());
+    }
+  for (Index k = 0; k < omega.size(); ++k)
+    if (!std::isfinite(omega[k]) || omega[k] < 0) {
+      std::ostringstream s;
+      s << "FrequencyResponse::compute: frequency " << k << " is " << omega[k]
+        << " rad/s; frequencies must be finite and non-negative";
+      throw NonFiniteError(s.str());
+    }
+  const Index p = static_cast<Index>(rows.size());
+  im.b = model_.B().col(input);
+  im.Cy.resize(p, n);
+  im.Cv.resize(p, n);
+  for (Index r = 0; r < p; ++r) {
+    im.Cy.row(r) = model_.C_y().row(rows[static_cast<std::size_t>(r)]).cast<cd>();
+    im.Cv.row(r) = model_.C_v().row(rows[static_cast<std::size_t>(r)]).cast<cd>();
+  }
+  im.z.resize(p);
+
+  FrfMethod m = options_.method;
+  if (m == FrfMethod::automatic) {
+    const Index bw = model_.bandwidth();
+    if (n >= 40 && bw <= std::max<Index>(1, n / 10))
+      m = FrfMethod::banded;
+    else if (n >= 12 && omega.size() >= 8)
+      m = FrfMethod::hessenberg;
+    else
+      m = FrfMethod::direct;
+  }
+  used_ = m;
+  switch (m) {
+    case FrfMethod::direct: im.prepare_direct(); break;
+    case FrfMethod::banded: im.prepare_banded(); break;
+    case FrfMethod::hessenberg:
+      im.prepare_hessenberg(options_.hessenberg_mass_rcond);
+      im.select_hessenberg();
+      im.colsum_ws.resize(im.N);
+      break;
+    case FrfMethod::modal:
+      im.prepare_modal(options_, warnings_);
+      im.select_modal(options_, warnings_);
+      break;
+    case FrfMethod::real:
+      im.prepare_real();
+      im.select_real();
+      break;
+    case FrfMethod::automatic: break;
+  }
+
+  const Index F = omega.size();
+  response_.resize(p, F);
+  rcond_.resize(F);
+  flags_.assign(static_cast<std::size_t>(F), FrfFlag::ok);
+  const double pole_rc =
+      options_.pole_rcond > 0 ? options_.pole_rcond : static_cast<double>(n) * kU;
+  for (Index k = 0; k < F; ++k) {
+    const double om = omega[k];
+    double rc = 0.0;
+    bool ok = false;
+    switch (m) {
+      case FrfMethod::direct: ok = im.point_direct(om, rc); break;
+      case FrfMethod::banded: ok = im.point_banded(om, rc); break;
+      case FrfMethod::hessenberg: ok = im.point_hessenberg(om, rc); break;
+      case FrfMethod::modal: ok = im.point_modal(om, rc); break;
+      case FrfMethod::real: ok = im.point_real(om, rc); break;
+      case FrfMethod::automatic: break;
+    }
+    rcond_[k] = rc;
+    FrfFlag flag = FrfFlag::ok;
+    if (!ok || !(rc > pole_rc) || !im.z.allFinite())
+      flag = FrfFlag::pole;
+    else if (rc < options_.ill_conditioned_rcond)
+      flag = FrfFlag::ill_conditioned;
+    flags_[static_cast<std::size_t>(k)] = flag;
+    if (flag == FrfFlag::pole) {
+      if (options_.on_pole == PoleHandling::raise) {
+        std::ostringstream s;
+        s << "FrequencyResponse::compute (" << to_string(m) << "): the system is singular at "
+          << hz(om) << ", rcond = " << rc << " (an undamped resonance?)";
+        throw SingularSystemError(s.str());
+      }
+      response_.col(k).setConstant(cd(kNaN, kNaN));
+    } else {
+      response_.col(k) = im.z;
+    }
+  }
+  info_ = Eigen::Success;
+  return *this;
+}
+
+}  // namespace mbsgen

@@ -1,0 +1,240 @@
+#include "mbsgen/runtime/linear_cli.hpp"
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "mbsgen/runtime/error.hpp"
+#include "mbsgen/runtime/frequency_response.hpp"
+#include "mbsgen/runtime/linear_model.hpp"
+#include "mbsgen/runtime/matrix_market.hpp"
+#include "mbsgen/runtime/quadratic_eigen.hpp"
+
+namespace mbsgen::cli {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+
+/// Full precision (17 significant digits) or "null" for a non-finite value (JSON has no NaN/Inf).
+std::string num(double v, bool json) {
+  if (!std::isfinite(v)) {
+    if (json) return "null";
+    if (std::isnan(v)) return "nan";
+    return v > 0 ? "inf" : "-inf";
+  }
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::string short_num(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6e", v);
+  return buf;
+}
+
+std::string pad(const std::string& s, std::size_t w) {
+  return s.size() >= w ? s : std::string(w - s.size(), ' ') + s;
+}
+
+struct Common {
+  std::string M, K, Q, format = "table";
+};
+
+LinearModel load(const Common& c, const std::string& Bf, const std::string& Cf,
+                 const std::string& Cvf) {
+  Eigen::MatrixXd M = read_matrix_market(c.M);
+  Eigen::MatrixXd K = read_matrix_market(c.K);
+  Eigen::MatrixXd Q = c.Q.empty() ? Eigen::MatrixXd() : read_matrix_market(c.Q);
+  Eigen::MatrixXd B = Bf.empty() ? Eigen::MatrixXd::Identity(M.rows(), M.rows())
+                                 : read_matrix_market(Bf);
+  Eigen::MatrixXd Cy = Cf.empty() ? Eigen::MatrixXd() : read_matrix_market(Cf);
+  Eigen::MatrixXd Cv = Cvf.empty() ? Eigen::MatrixXd() : read_matrix_market(Cvf);
+  return LinearModel(std::move(M), std::move(Q), std::move(K), std::move(B), std::move(Cy),
+                     std::move(Cv));
+}
+
+int run_modes(const Common& c, bool all, std::ostream& out) {
+  const LinearModel model = load(c, "", "", "");
+  QuadraticEigenOptions opt;
+  opt.one_per_conjugate_pair = !all;
+  QuadraticEigenSolver solver(model.size(), opt);
+  solver.compute(model);
+  const auto& modes = solver.modes();
+  if (c.format == "json") {
+    out << "{\"modes\":[";
+    for (std::size_t k = 0; k < modes.size(); ++k) {
+      const Mode& m = modes[k];
+      out << (k ? ",\n" : "\n") << "{\"lambda_re\":" << num(m.lambda.real(), true)
+          << ",\"lambda_im\":" << num(m.lambda.imag(), true)
+          << ",\"natural_frequency_hz\":" << num(m.natural_frequency_hz, true)
+          << ",\"damped_frequency_hz\":" << num(m.damped_frequency_hz, true)
+          << ",\"damping_ratio\":" << num(m.damping_ratio, true)
+          << ",\"backward_error\":" << num(m.backward_error, true) << ",\"kind\":\""
+          << to_string(m.kind) << "\"}";
+    }
+    out << "\n]}\n";
+  } else if (c.format == "csv") {
+    out << "lambda_re,lambda_im,natural_frequency_hz,damped_frequency_hz,damping_ratio,"
+           "backward_error,kind\n";
+    for (const Mode& m : modes)
+      out << num(m.lambda.real(), false) << "," << num(m.lambda.imag(), false) << ","
+          << num(m.natural_frequency_hz, false) << "," << num(m.damped_frequency_hz, false)
+          << "," << num(m.damping_ratio, false) << "," << num(m.backward_error, false) << ","
+          << to_string(m.kind) << "\n";
+  } else {
+    out << pad("#", 4) << pad("lambda_re", 15) << pad("lambda_im", 15) << pad("f_n [Hz]", 15)
+        << pad("f_d [Hz]", 15) << pad("zeta", 15) << pad("backward_err", 15) << "  kind\n";
+    int k = 1;
+    for (const Mode& m : modes)
+      out << pad(std::to_string(k++), 4) << pad(short_num(m.lambda.real()), 15)
+          << pad(short_num(m.lambda.imag()), 15) << pad(short_num(m.natural_frequency_hz), 15)
+          << pad(short_num(m.damped_frequency_hz), 15) << pad(short_num(m.damping_ratio), 15)
+          << pad(short_num(m.backward_error), 15) << "  " << to_string(m.kind) << "\n";
+    out << "# method " << solver.method() << ", rank M " << solver.rank_M() << "/"
+        << model.size() << ", rank K " << solver.rank_K() << "/" << model.size() << "\n";
+  }
+  return 0;
+}
+
+struct FrfArgs {
+  std::string B, C, Cv, method = "auto", spacing = "log", on_pole = "flag";
+  long input = 1, output = 1, points = 200;
+  double from = 1.0, to = 1000.0;
+};
+
+int run_frf(const Common& c, const FrfArgs& a, std::ostream& out, std::ostream& err) {
+  const LinearModel model = load(c, a.B, a.C, a.Cv);
+  if (a.input < 1 || a.input > model.num_inputs())
+    throw DimensionError("--input " + std::to_string(a.input) + " out of range 1.." +
+                         std::to_string(model.num_inputs()));
+  if (a.output < 1 || a.output > model.num_outputs())
+    throw DimensionError("--output " + std::to_string(a.output) + " out of range 1.." +
+                         std::to_string(model.num_outputs()));
+  Eigen::VectorXd hz(a.points);
+  for (long k = 0; k < a.points; ++k) {
+    const double t = a.points == 1 ? 0.0 : static_cast<double>(k) / static_cast<double>(a.points - 1);
+    hz[k] = a.spacing == "log" ? a.from * std::pow(a.to / a.from, t) : a.from + (a.to - a.from) * t;
+  }
+  if (a.points > 0) hz[a.points - 1] = a.to;
+  FrfOptions opt;
+  opt.method = parse_frf_method(a.method);
+  opt.on_pole = a.on_pole == "error" ? PoleHandling::raise : PoleHandling::flag;
+  FrequencyResponse frf(model, opt);
+  frf.compute(hz * kTwoPi, a.input - 1, {a.output - 1});
+  for (const auto& w : frf.warnings()) err << "mbsgen linear frf: warning: " << w << "\n";
+  const auto& g = frf.response();
+  if (c.format == "json") {
+    out << "{\"input\":" << a.input << ",\"output\":" << a.output << ",\"points\":[";
+    for (long k = 0; k < a.points; ++k) {
+      const std::complex<double> v = g(0, k);
+      out << (k ? ",\n" : "\n") << "{\"frequency_hz\":" << num(hz[k], true)
+          << ",\"re\":" << num(v.real(), true) << ",\"im\":" << num(v.imag(), true)
+          << ",\"amplitude\":" << num(amplitude(v), true)
+          << ",\"phase_lag_deg\":" << num(phase_lag(v) * 180.0 / kPi, true)
+          << ",\"rcond\":" << num(frf.rcond()[k], true) << ",\"flag\":\""
+          << to_string(frf.flags()[static_cast<std::size_t>(k)]) << "\"}";
+    }
+    out << "\n]}\n";
+  } else if (c.format == "csv") {
+    out << "frequency_hz,re,im,amplitude,phase_lag_deg,rcond,flag\n";
+    for (long k = 0; k < a.points; ++k) {
+      const std::complex<double> v = g(0, k);
+      out << num(hz[k], false) << "," << num(v.real(), false) << "," << num(v.imag(), false)
+          << "," << num(amplitude(v), false) << "," << num(phase_lag(v) * 180.0 / kPi, false)
+          << "," << num(frf.rcond()[k], false) << ","
+          << to_string(frf.flags()[static_cast<std::size_t>(k)]) << "\n";
+    }
+  } else {
+    out << pad("f [Hz]", 15) << pad("re", 15) << pad("im", 15) << pad("amplitude", 15)
+        << pad("phase_lag[deg]", 15) << pad("rcond", 15) << "  flag\n";
+    for (long k = 0; k < a.points; ++k) {
+      const std::complex<double> v = g(0, k);
+      out << pad(short_num(hz[k]), 15) << pad(short_num(v.real()), 15)
+          << pad(short_num(v.imag()), 15) << pad(short_num(amplitude(v)), 15)
+          << pad(short_num(phase_lag(v) * 180.0 / kPi), 15) << pad(short_num(frf.rcond()[k]), 15)
+          << "  " << to_string(frf.flags()[static_cast<std::size_t>(k)]) << "\n";
+    }
+    out << "# input " << a.input << ", output " << a.output << ", method "
+        << to_string(frf.method()) << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{"mbsgen linear: modes and frequency responses of M y'' + Q y' + K y = B u, "
+               "z = C y, from Matrix Market files"};
+  app.name("mbsgen linear");
+  app.require_subcommand(1);
+  Common c;
+  bool all = false;
+  FrfArgs a;
+  auto add_common = [&c](CLI::App* s) {
+    s->add_option("--M", c.M, "mass matrix M (f x f), Matrix Market")->required()
+        ->check(CLI::ExistingFile);
+    s->add_option("--K", c.K, "stiffness matrix K (f x f)")->required()->check(CLI::ExistingFile);
+    s->add_option("--Q", c.Q, "velocity (damping + gyroscopic) matrix Q (f x f); default 0")
+        ->check(CLI::ExistingFile);
+    s->add_option("--format", c.format, "output format")
+        ->check(CLI::IsMember({"table", "json", "csv"}));
+  };
+  CLI::App* modes = app.add_subcommand("modes", "eigenvalues and modes of λ²M + λQ + K");
+  add_common(modes);
+  modes->add_flag("--all", all, "report both members of each complex-conjugate pair");
+  CLI::App* frf = app.add_subcommand("frf", "frequency response z/u of one input and one output");
+  add_common(frf);
+  frf->add_option("--B", a.B, "input matrix B (f x m); default identity (unit force per coordinate)")
+      ->check(CLI::ExistingFile);
+  frf->add_option("--C", a.C, "output matrix C_y (p x f); default identity (outputs = coordinates)")
+      ->check(CLI::ExistingFile);
+  frf->add_option("--Cv", a.Cv, "velocity output matrix C_v (p x f); default 0")
+      ->check(CLI::ExistingFile);
+  frf->add_option("--input", a.input, "input: column of B, 1-based")->check(CLI::PositiveNumber);
+  frf->add_option("--output", a.output, "output: row of C, 1-based")->check(CLI::PositiveNumber);
+  frf->add_option("--from", a.from, "first frequency [Hz]")->check(CLI::NonNegativeNumber);
+  frf->add_option("--to", a.to, "last frequency [Hz]")->check(CLI::NonNegativeNumber);
+  frf->add_option("--points", a.points, "number of frequencies")->check(CLI::PositiveNumber);
+  frf->add_option("--spacing", a.spacing, "frequency spacing")
+      ->check(CLI::IsMember({"log", "linear"}));
+  frf->add_option("--method", a.method, "solution method")
+      ->check(CLI::IsMember({"auto", "direct", "banded", "hessenberg", "modal", "real"}));
+  frf->add_option("--on-pole", a.on_pole,
+                  "at a pole of an undamped system: flag the point, or fail with exit code 1")
+      ->check(CLI::IsMember({"flag", "error"}));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    out << app.help();
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) {
+      out << app.help();
+      return 0;
+    }
+    err << "mbsgen linear: " << e.what() << "\n";
+    return 2;
+  }
+  if (frf->parsed() && a.spacing == "log" && (a.from <= 0 || a.to <= 0)) {
+    err << "mbsgen linear frf: --spacing log needs --from and --to > 0\n";
+    return 2;
+  }
+  try {
+    if (modes->parsed()) return run_modes(c, all, out);
+    return run_frf(c, a, out, err);
+  } catch (const Error& e) {
+    err << "mbsgen linear: error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+int linear_main(int argc, char** argv) { return linear_main(argc, argv, std::cout, std::cerr); }
+
+}  // namespace mbsgen::cli
