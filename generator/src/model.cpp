@@ -1,5 +1,6 @@
 #include "mbsgen/generator/model.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <set>
@@ -39,9 +40,11 @@ Model::Model(std::string name) : name_(std::move(name)) {}
 void Model::check_new_symbol(const std::string& name, const SourceLocation& where) {
   static const std::set<std::string> reserved = {"sin", "cos", "tan", "exp", "log", "sqrt", "abs",
                                                  "asin", "acos", "atan", "atan2", "sinh", "cosh",
-                                                 "tanh", "Pi", "I", "pow", "world"};
-  if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_'))
-    throw ModelError(where, "'" + name + "' is not a valid name (letters, digits and _)");
+                                                 "tanh", "Pi", "I", "Euler", "Catalan", "pow",
+                                                 "world"};
+  // A letter first: GiNaC's lexer reads an identifier only from a letter.
+  if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0])))
+    throw ModelError(where, "'" + name + "' is not a valid name (a letter, then letters, digits and _)");
   for (char c : name)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_'))
       throw ModelError(where, "'" + name + "' is not a valid name (letters, digits and _)");
