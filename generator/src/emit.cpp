@@ -320,7 +320,7 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
 GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin,
                    const EmitOptions& options) {
   GeneratedCode out;
-  out.id = identifier(model.name());
+  out.id = identifier(options.id.empty() ? model.name() : options.id);
   const std::size_t f = eq.y.size(), m = eq.u.size(), r = eq.outputs.size();
   const std::size_t nb = model.bodies().size();
   std::vector<ex> y(eq.y.begin(), eq.y.end()), yd(eq.yd.begin(), eq.yd.end()),

@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
 #endif
   CLI::App app{"mbsgen: symbolic-to-numeric code generator for multibody systems"};
   app.require_subcommand(1);
-  std::string model_file, out_dir, scene = "full";
+  std::string model_file, out_dir, scene = "full", id;
   bool no_cse = false;
   auto* check = app.add_subcommand("check", "read and validate a model file");
   check->add_option("MODEL", model_file, "model file (YAML)")->required();
@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
   generate->add_option("MODEL", model_file, "model file (YAML)")->required();
   generate->add_option("--out", out_dir, "output directory")->required();
   generate->add_option("--scene", scene, "scene to generate (default: the full model)");
+  generate->add_option("--id", id, "C identifier prefix of the kernels (default: the model name)");
   generate->add_flag("--no-cse", no_cse, "skip common-subexpression elimination");
   app.add_subcommand("linear", "modes and frequency responses of raw matrices (mbsgen linear --help)");
   try {
@@ -78,6 +79,7 @@ int main(int argc, char** argv) {
     options.cse = !no_cse;
     options.scene = scene;
     options.source_file = model_file;
+    options.id = id;
     mbsgen::GeneratedCode code = mbsgen::emit(model, eq, lin, options);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (*info) return print_info(model, code, seconds);

@@ -19,6 +19,7 @@ struct EmitOptions {
   bool cse = true;
   std::string scene = "full";
   std::string source_file;  ///< shown in the header; the model file as given
+  std::string id;           ///< C identifier prefix of the kernels (default: from the model name)
 };
 
 struct KernelInfo {

@@ -1,0 +1,23 @@
+// Writes the generated kernels of a model built through the C++ API (chain.hpp):
+//   gen_api_models planar|spatial N ID OUT_DIR
+#include "mbsgen/generator/chain.hpp"
+#include "mbsgen/generator/emit.hpp"
+
+#include <iostream>
+#include <string>
+
+int main(int argc, char** argv) {
+  if (argc != 5) {
+    std::cerr << "usage: gen_api_models planar|spatial N ID OUT_DIR\n";
+    return 2;
+  }
+  const std::string kind = argv[1];
+  const int n = std::stoi(argv[2]);
+  mbsgen::Model model = kind == "planar" ? mbsgen::planar_chain(n) : mbsgen::spatial_chain(n);
+  mbsgen::Equations eq = mbsgen::derive(model);
+  mbsgen::LinearEquations lin = mbsgen::linearize(eq);
+  mbsgen::EmitOptions options;
+  options.id = argv[3];
+  mbsgen::write_generated(mbsgen::emit(model, eq, lin, options), argv[4]);
+  return 0;
+}
