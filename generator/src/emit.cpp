@@ -304,8 +304,7 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
   std::ostringstream code;
   code << "// " << k.doc << "\n// operations: " << printer.operations << "\n";
   code << "extern \"C\" " << sig.str() << " {\n";
-  for (const auto& a : k.inputs)
-    if (a.symbols.empty()) code << "  (void)" << a.name << ";\n";
+  for (const auto& a : k.inputs) code << "  (void)" << a.name << ";\n";
   code << body.str();
   code << "  int status = 0;\n";
   for (const auto& b : k.outputs)

@@ -1,0 +1,15 @@
+# Generates MODEL twice into separate directories and fails unless the files are byte-identical.
+foreach(_run a b)
+  execute_process(COMMAND ${MBSGEN} generate ${MODEL} --id det --out ${OUT}/${_run}
+                  RESULT_VARIABLE _rc)
+  if(NOT _rc EQUAL 0)
+    message(FATAL_ERROR "mbsgen generate failed (${_rc})")
+  endif()
+endforeach()
+foreach(_ext hpp cpp json)
+  file(READ ${OUT}/a/det.${_ext} _a)
+  file(READ ${OUT}/b/det.${_ext} _b)
+  if(NOT _a STREQUAL _b)
+    message(FATAL_ERROR "det.${_ext} differs between two runs of mbsgen generate")
+  endif()
+endforeach()
