@@ -46,6 +46,34 @@ void normalize_pair(cd& alpha, double& beta) {
   }
 }
 
+/// M X, Q X, K X for a complex n×m block X by real matrix products (BLAS-3 speed).
+struct Products {
+  Eigen::MatrixXcd MX, QX, KX;
+  Products(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& K,
+           const Eigen::MatrixXcd& X) {
+    const Eigen::MatrixXd Xr = X.real(), Xi = X.imag();
+    auto mul = [&](const Eigen::MatrixXd& A, Eigen::MatrixXcd& out) {
+      out.resize(X.rows(), X.cols());
+      out.real().noalias() = A * Xr;
+      out.imag().noalias() = A * Xi;
+    };
+    mul(M, MX);
+    mul(Q, QX);
+    mul(K, KX);
+  }
+  /// Tisseur's backward error of (α, β, x_k) with x_k = column k of X.
+  double backward_error(Eigen::Index k, cd alpha, double beta, double xnorm, double nM, double nQ,
+                        double nK) const {
+    const double r =
+        ((alpha * alpha) * MX.col(k) + (alpha * beta) * QX.col(k) + (beta * beta) * KX.col(k))
+            .norm();
+    const double a = std::abs(alpha);
+    const double den = (a * a * nM + a * beta * nQ + beta * beta * nK) * xnorm;
+    if (den == 0.0) return r == 0.0 ? 0.0 : kInf;
+    return r / den;
+  }
+};
+
 }  // namespace
 
 const char* to_string(EigenvalueKind kind) {
@@ -207,37 +235,38 @@ void QuadraticEigenSolver::compute_general(const Eigen::MatrixXd& M, const Eigen
     if (info > 0) throw LapackError("QuadraticEigenSolver::compute: QZ iteration (dggevx) failed");
     out.clear();
     out.reserve(static_cast<std::size_t>(N));
-    Eigen::VectorXcd z(N), w(N);
+    // Complex eigenvectors z = [top; bottom] and the bottom blocks of the left ones.
+    Eigen::MatrixXcd Z(N, N), W(n, N);
     for (Eigen::Index j = 0; j < N; ++j) {
       if (alphai_[j] == 0.0) {
-        z = VR_.col(j).cast<cd>();
-        w = VL_.col(j).cast<cd>();
+        Z.col(j) = VR_.col(j).cast<cd>();
+        W.col(j) = VL_.col(j).tail(n).cast<cd>();
       } else if (alphai_[j] > 0.0) {
-        z.real() = VR_.col(j);
-        z.imag() = VR_.col(j + 1);
-        w.real() = VL_.col(j);
-        w.imag() = VL_.col(j + 1);
+        Z.col(j).real() = VR_.col(j);
+        Z.col(j).imag() = VR_.col(j + 1);
+        W.col(j).real() = VL_.col(j).tail(n);
+        W.col(j).imag() = VL_.col(j + 1).tail(n);
       } else {  // second of a pair: conjugates of the previous column pair
-        z.real() = VR_.col(j - 1);
-        z.imag() = -VR_.col(j);
-        w.real() = VL_.col(j - 1);
-        w.imag() = -VL_.col(j);
+        Z.col(j).real() = VR_.col(j - 1);
+        Z.col(j).imag() = -VR_.col(j);
+        W.col(j).real() = VL_.col(j - 1).tail(n);
+        W.col(j).imag() = -VL_.col(j).tail(n);
       }
+    }
+    const Eigen::MatrixXcd top = Z.topRows(n), bottom = Z.bottomRows(n);
+    const Products pt(M, Q, K, top), pb(M, Q, K, bottom);
+    for (Eigen::Index j = 0; j < N; ++j) {
       Raw r;
       r.alpha = g * cd(alphar_[j], alphai_[j]);
       r.beta = beta_[j];
       normalize_pair(r.alpha, r.beta);
-      const Eigen::VectorXcd top = z.head(n), bottom = z.tail(n);
+      const double nt = top.col(j).norm(), nb = bottom.col(j).norm();
       const double e_top =
-          top.norm() > 0 ? quadratic_backward_error(M, Q, K, r.alpha, r.beta, top, norm_M_,
-                                                    norm_Q_, norm_K_)
-                         : kInf;
+          nt > 0 ? pt.backward_error(j, r.alpha, r.beta, nt, norm_M_, norm_Q_, norm_K_) : kInf;
       const double e_bot =
-          bottom.norm() > 0 ? quadratic_backward_error(M, Q, K, r.alpha, r.beta, bottom, norm_M_,
-                                                       norm_Q_, norm_K_)
-                            : kInf;
-      r.x = e_top <= e_bot ? top : bottom;
-      r.y = w.tail(n);
+          nb > 0 ? pb.backward_error(j, r.alpha, r.beta, nb, norm_M_, norm_Q_, norm_K_) : kInf;
+      r.x = e_top <= e_bot ? top.col(j) : bottom.col(j);
+      r.y = W.col(j);
       out.push_back(std::move(r));
     }
   };
@@ -332,53 +361,61 @@ void QuadraticEigenSolver::compute_general(const Eigen::MatrixXd& M, const Eigen
 
 void QuadraticEigenSolver::finish(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
                                   const Eigen::MatrixXd& K) {
-  const Eigen::MatrixXcd Mc = M.cast<cd>(), Qc = Q.cast<cd>(), Kc = K.cast<cd>();
-  for (Mode& m : modes_) {
-    normalize_shape(m.shape);
-    normalize_shape(m.left_shape);
-    const Eigen::VectorXcd& x = m.shape;
-    const Eigen::VectorXcd& y = m.left_shape;
+  const Eigen::Index n = M.rows(), m = static_cast<Eigen::Index>(modes_.size());
+  Eigen::MatrixXcd X(n, m), Y(n, m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    Mode& md = modes_[static_cast<std::size_t>(k)];
+    normalize_shape(md.shape);
+    normalize_shape(md.left_shape);
+    X.col(k) = md.shape;
+    Y.col(k) = md.left_shape;
+  }
+  const Products px(M, Q, K, X);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    Mode& md = modes_[static_cast<std::size_t>(k)];
+    const auto y = Y.col(k);
     // Homogeneous condition number (Dedieu & Tisseur 2003) of the computed pair.
     {
-      const cd a = m.alpha;
-      const double b = m.beta;
-      const Eigen::VectorXcd Da = 2.0 * a * (Mc * x) + b * (Qc * x);
-      const Eigen::VectorXcd Db = a * (Qc * x) + 2.0 * b * (Kc * x);
+      const cd a = md.alpha;
+      const double b = md.beta;
+      const Eigen::VectorXcd Da = 2.0 * a * px.MX.col(k) + b * px.QX.col(k);
+      const Eigen::VectorXcd Db = a * px.QX.col(k) + 2.0 * b * px.KX.col(k);
       const cd den = y.dot(b * Da - std::conj(a) * Db);  // y.dot(v) = yᴴv
       const double aa = std::norm(a);
       const double num = std::sqrt(aa * aa * norm_M_ * norm_M_ + aa * b * b * norm_Q_ * norm_Q_ +
                                    b * b * b * b * norm_K_ * norm_K_);
-      m.condition_homogeneous = std::abs(den) > 0 ? num / std::abs(den) : kInf;
+      md.condition_homogeneous = std::abs(den) > 0 ? num / std::abs(den) : kInf;
     }
-    switch (m.kind) {
+    const double xn = X.col(k).norm();
+    switch (md.kind) {
       case EigenvalueKind::zero:
-        m.lambda = 0.0;
-        m.natural_frequency_hz = 0.0;
-        m.damped_frequency_hz = 0.0;
-        m.damping_ratio = std::numeric_limits<double>::quiet_NaN();
-        m.backward_error = quadratic_backward_error(M, Q, K, 0.0, 1.0, x, norm_M_, norm_Q_, norm_K_);
-        m.condition = kInf;
+        md.lambda = 0.0;
+        md.natural_frequency_hz = 0.0;
+        md.damped_frequency_hz = 0.0;
+        md.damping_ratio = std::numeric_limits<double>::quiet_NaN();
+        md.backward_error = px.backward_error(k, 0.0, 1.0, xn, norm_M_, norm_Q_, norm_K_);
+        md.condition = kInf;
         break;
       case EigenvalueKind::infinite:
-        m.lambda = kInf;
-        m.natural_frequency_hz = kInf;
-        m.damped_frequency_hz = 0.0;
-        m.damping_ratio = 0.0;
-        m.backward_error = quadratic_backward_error(M, Q, K, 1.0, 0.0, x, norm_M_, norm_Q_, norm_K_);
-        m.condition = kInf;
+        md.lambda = kInf;
+        md.natural_frequency_hz = kInf;
+        md.damped_frequency_hz = 0.0;
+        md.damping_ratio = 0.0;
+        md.backward_error = px.backward_error(k, 1.0, 0.0, xn, norm_M_, norm_Q_, norm_K_);
+        md.condition = kInf;
         break;
       case EigenvalueKind::finite: {
-        const cd lam = m.alpha / m.beta;
-        m.lambda = lam;
+        const cd lam = md.alpha / md.beta;
+        md.lambda = lam;
         const double r = std::abs(lam);
-        m.natural_frequency_hz = r / kTwoPi;
-        m.damped_frequency_hz = lam.imag() / kTwoPi;
-        m.damping_ratio = r > 0 ? -lam.real() / r + 0.0 : std::numeric_limits<double>::quiet_NaN();
-        m.backward_error = quadratic_backward_error(M, Q, K, m.alpha, m.beta, x, norm_M_, norm_Q_,
-                                                    norm_K_);
-        const cd d = y.dot(2.0 * lam * (Mc * x) + Qc * x);
+        md.natural_frequency_hz = r / kTwoPi;
+        md.damped_frequency_hz = lam.imag() / kTwoPi;
+        md.damping_ratio = r > 0 ? -lam.real() / r + 0.0 : std::numeric_limits<double>::quiet_NaN();
+        md.backward_error =
+            px.backward_error(k, md.alpha, md.beta, xn, norm_M_, norm_Q_, norm_K_);
+        const cd d = y.dot(2.0 * lam * px.MX.col(k) + px.QX.col(k));
         const double num = (r * r * norm_M_ + r * norm_Q_ + norm_K_);
-        m.condition = (r > 0 && std::abs(d) > 0) ? num / (r * std::abs(d)) : kInf;
+        md.condition = (r > 0 && std::abs(d) > 0) ? num / (r * std::abs(d)) : kInf;
         break;
       }
     }
@@ -391,6 +428,19 @@ void QuadraticEigenSolver::finish(const Eigen::MatrixXd& M, const Eigen::MatrixX
     if (ra != rb) return ra < rb;
     return a.lambda.imag() > b.lambda.imag();
   });
+  // Members of a conjugate pair computed as two separate eigenvalues (undamped problems) can
+  // differ in |λ| by rounding: put the one with Im λ > 0 first.
+  for (std::size_t k = 0; k + 1 < modes_.size(); ++k) {
+    Mode& a = modes_[k];
+    Mode& b = modes_[k + 1];
+    if (a.kind != EigenvalueKind::finite || b.kind != EigenvalueKind::finite) continue;
+    const double ra = std::abs(a.lambda), rb = std::abs(b.lambda);
+    if (std::abs(ra - rb) <= 1e-8 * std::max(ra, rb) && a.lambda.imag() < 0 &&
+        b.lambda.imag() > 0 && std::abs(a.lambda - std::conj(b.lambda)) <= 1e-8 * ra) {
+      std::swap(a, b);
+      ++k;
+    }
+  }
 }
 
 }  // namespace mbsgen

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "mbsgen/runtime/error.hpp"
+
 namespace mbsgen {
 
 /// Read-only description of a linear second-order model with f coordinates, m inputs and
