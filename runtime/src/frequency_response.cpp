@@ -276,19 +276,29 @@ struct FrequencyResponse::Impl {
   Eigen::MatrixXcd Chat;             // p×N reduced outputs
   std::string hess_form;
 
+  /// LU of M exists (no zero pivot) and its 1-norm rcond estimate is at least `threshold`.
+  bool mass_is_regular(double threshold) const {
+    if (!(Mlu.matrixLU().diagonal().cwiseAbs().minCoeff() > 0.0)) return false;
+    const double rc = Mlu.rcond();
+    return std::isfinite(rc) && rc >= threshold;
+  }
+
   void prepare_hessenberg(double mass_rcond) {
     if (hess_ready) return;
     const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
     N = 2 * n;
     const lapack_int NN = detail::li(N);
     Mlu.compute(M);
-    hess_standard = Mlu.rcond() >= mass_rcond;
+    hess_standard = mass_is_regular(mass_rcond);
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(N, N);
     A.topRightCorner(n, n).setIdentity();
     if (hess_standard) {
-      hess_form = "standard";
       A.bottomLeftCorner(n, n) = -Mlu.solve(K);
       A.bottomRightCorner(n, n) = -Mlu.solve(Q);
+      hess_standard = A.allFinite();
+    }
+    if (hess_standard) {
+      hess_form = "standard";
       Eigen::VectorXd scale(N);
       lapack_int info = LAPACKE_dgebal(LAPACK_COL_MAJOR, 'B', NN, A.data(), NN, &hilo, &hihi,
                                        scale.data());
@@ -311,6 +321,8 @@ struct FrequencyResponse::Impl {
       reflectors = std::move(A);
     } else {
       hess_form = "pencil";
+      A.setZero();
+      A.topRightCorner(n, n).setIdentity();
       A.bottomLeftCorner(n, n) = -K;
       A.bottomRightCorner(n, n) = -Q;
       Eigen::MatrixXd E = Eigen::MatrixXd::Zero(N, N);
@@ -339,8 +351,8 @@ struct FrequencyResponse::Impl {
       detail::check_lapack(info, "dormqr", "FrequencyResponse (hessenberg)");
       qr_E = E;
       Eigen::MatrixXd R = E.triangularView<Eigen::Upper>();
-      Qleft.resize(N, N);
-      Zright.resize(N, N);
+      Qleft.setIdentity(N, N);  // LAPACKE checks them for NaN even with compq = compz = 'I'
+      Zright.setIdentity(N, N);
       info = LAPACKE_dgghrd(LAPACK_COL_MAJOR, 'I', 'I', NN, hilo, hihi, A.data(), NN, R.data(),
                             NN, Qleft.data(), NN, Zright.data(), NN);
       detail::check_lapack(info, "dgghrd", "FrequencyResponse (hessenberg)");
@@ -538,7 +550,7 @@ struct FrequencyResponse::Impl {
     if (real_ready) return;
     N = 2 * n;
     Mlu.compute(model.M());
-    if (!(Mlu.rcond() > 1e3 * kU))
+    if (!mass_is_regular(1e3 * kU))
       throw SingularSystemError(
           "FrequencyResponse (real): M is singular or nearly so (rcond " +
           std::to_string(Mlu.rcond()) + "); the real formulation needs A = [[0,E],[-M^-1 K, "

@@ -59,9 +59,11 @@ struct FrfOptions {
   Eigen::Index modal_modes = 0;
   /// modal with truncation: add the static (residual) correction K⁻¹b − Σ_kept (needs K regular).
   bool static_correction = true;
-  /// modal: refuse (IllConditionedError) when the 1-norm condition estimate of the normalized
+  /// modal: refuse (IllConditionedError) when the 1-norm condition estimate κ of the normalized
   /// eigenvector matrix of the linearization exceeds this, unless modal_allow_ill_conditioned.
-  double modal_max_condition = 1e8;
+  /// The modal sum loses about log10(κ) digits; 1e6 keeps about 10 (a defective pair, split by
+  /// O(√u) in floating point, has κ ≈ 1e8).
+  double modal_max_condition = 1e6;
   bool modal_allow_ill_conditioned = false;  ///< then only a warning is recorded
   /// hessenberg: use the standard form A = [[0, E], [−M⁻¹K, −M⁻¹Q]] (via an LU of M, never
   /// M⁻¹ itself; dgebal + dgehrd, blocked and fast) when rcond₁(M) ≥ this; otherwise the
