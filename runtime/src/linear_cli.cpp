@@ -179,10 +179,10 @@ int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   FrfArgs a;
   auto add_common = [&c](CLI::App* s) {
     s->add_option("--M", c.M, "mass matrix M (f x f), Matrix Market")->required()
-        ->check(CLI::ExistingFile);
-    s->add_option("--K", c.K, "stiffness matrix K (f x f)")->required()->check(CLI::ExistingFile);
+;
+    s->add_option("--K", c.K, "stiffness matrix K (f x f)")->required();
     s->add_option("--Q", c.Q, "velocity (damping + gyroscopic) matrix Q (f x f); default 0")
-        ->check(CLI::ExistingFile);
+;
     s->add_option("--format", c.format, "output format")
         ->check(CLI::IsMember({"table", "json", "csv"}));
   };
@@ -192,16 +192,16 @@ int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   CLI::App* frf = app.add_subcommand("frf", "frequency response z/u of one input and one output");
   add_common(frf);
   frf->add_option("--B", a.B, "input matrix B (f x m); default identity (unit force per coordinate)")
-      ->check(CLI::ExistingFile);
+;
   frf->add_option("--C", a.C, "output matrix C_y (p x f); default identity (outputs = coordinates)")
-      ->check(CLI::ExistingFile);
+;
   frf->add_option("--Cv", a.Cv, "velocity output matrix C_v (p x f); default 0")
-      ->check(CLI::ExistingFile);
-  frf->add_option("--input", a.input, "input: column of B, 1-based")->check(CLI::PositiveNumber);
-  frf->add_option("--output", a.output, "output: row of C, 1-based")->check(CLI::PositiveNumber);
+;
+  frf->add_option("--input", a.input, "input: column of B, 1-based")->check(CLI::Range(1L, 1000000000L));
+  frf->add_option("--output", a.output, "output: row of C, 1-based")->check(CLI::Range(1L, 1000000000L));
   frf->add_option("--from", a.from, "first frequency [Hz]")->check(CLI::NonNegativeNumber);
   frf->add_option("--to", a.to, "last frequency [Hz]")->check(CLI::NonNegativeNumber);
-  frf->add_option("--points", a.points, "number of frequencies")->check(CLI::PositiveNumber);
+  frf->add_option("--points", a.points, "number of frequencies")->check(CLI::Range(1L, 1000000000L));
   frf->add_option("--spacing", a.spacing, "frequency spacing")
       ->check(CLI::IsMember({"log", "linear"}));
   frf->add_option("--method", a.method, "solution method")
