@@ -283,11 +283,12 @@ struct FrequencyResponse::Impl {
     return std::isfinite(rc) && rc >= threshold;
   }
 
-  void prepare_hessenberg(double mass_rcond) {
+  void prepare_hessenberg(double mass_rcond, bool balance) {
     if (hess_ready) return;
     const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
     N = 2 * n;
     const lapack_int NN = detail::li(N);
+    const char job = balance ? 'B' : 'N';
     Mlu.compute(M);
     hess_standard = mass_is_regular(mass_rcond);
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(N, N);
@@ -300,16 +301,16 @@ struct FrequencyResponse::Impl {
     if (hess_standard) {
       hess_form = "standard";
       Eigen::VectorXd scale(N);
-      lapack_int info = LAPACKE_dgebal(LAPACK_COL_MAJOR, 'B', NN, A.data(), NN, &hilo, &hihi,
+      lapack_int info = LAPACKE_dgebal(LAPACK_COL_MAJOR, job, NN, A.data(), NN, &hilo, &hihi,
                                        scale.data());
       detail::check_lapack(info, "dgebal", "FrequencyResponse (hessenberg)");
       Eigen::MatrixXd I = Eigen::MatrixXd::Identity(N, N);
-      info = LAPACKE_dgebak(LAPACK_COL_MAJOR, 'B', 'R', NN, hilo, hihi, scale.data(), NN,
+      info = LAPACKE_dgebak(LAPACK_COL_MAJOR, job, 'R', NN, hilo, hihi, scale.data(), NN,
                             I.data(), NN);
       detail::check_lapack(info, "dgebak", "FrequencyResponse (hessenberg)");
       Xr.from_dense(I);
       I.setIdentity();
-      info = LAPACKE_dgebak(LAPACK_COL_MAJOR, 'B', 'L', NN, hilo, hihi, scale.data(), NN,
+      info = LAPACKE_dgebak(LAPACK_COL_MAJOR, job, 'L', NN, hilo, hihi, scale.data(), NN,
                             I.data(), NN);
       detail::check_lapack(info, "dgebak", "FrequencyResponse (hessenberg)");
       Xl.from_dense(I);
@@ -329,16 +330,16 @@ struct FrequencyResponse::Impl {
       E.topLeftCorner(n, n).setIdentity();
       E.bottomRightCorner(n, n) = M;
       Eigen::VectorXd lscale(N), rscale(N);
-      lapack_int info = LAPACKE_dggbal(LAPACK_COL_MAJOR, 'B', NN, A.data(), NN, E.data(), NN,
+      lapack_int info = LAPACKE_dggbal(LAPACK_COL_MAJOR, job, NN, A.data(), NN, E.data(), NN,
                                        &hilo, &hihi, lscale.data(), rscale.data());
       detail::check_lapack(info, "dggbal", "FrequencyResponse (hessenberg)");
       Eigen::MatrixXd I = Eigen::MatrixXd::Identity(N, N);
-      info = LAPACKE_dggbak(LAPACK_COL_MAJOR, 'B', 'R', NN, hilo, hihi, lscale.data(),
+      info = LAPACKE_dggbak(LAPACK_COL_MAJOR, job, 'R', NN, hilo, hihi, lscale.data(),
                             rscale.data(), NN, I.data(), NN);
       detail::check_lapack(info, "dggbak", "FrequencyResponse (hessenberg)");
       Xr.from_dense(I);
       I.setIdentity();
-      info = LAPACKE_dggbak(LAPACK_COL_MAJOR, 'B', 'L', NN, hilo, hihi, lscale.data(),
+      info = LAPACKE_dggbak(LAPACK_COL_MAJOR, job, 'L', NN, hilo, hihi, lscale.data(),
                             rscale.data(), NN, I.data(), NN);
       detail::check_lapack(info, "dggbak", "FrequencyResponse (hessenberg)");
       Xl.from_dense(I);
@@ -662,7 +663,7 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
     case FrfMethod::direct: im.prepare_direct(); break;
     case FrfMethod::banded: im.prepare_banded(); break;
     case FrfMethod::hessenberg:
-      im.prepare_hessenberg(options_.hessenberg_mass_rcond);
+      im.prepare_hessenberg(options_.hessenberg_mass_rcond, options_.balance);
       im.select_hessenberg();
       im.colsum_ws.resize(im.N);
       break;

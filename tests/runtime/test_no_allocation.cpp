@@ -1,0 +1,66 @@
+// The per-frequency loop of FrequencyResponse does not allocate (issue 3 §1): malloc is
+// interposed in this executable and the allocations of compute() are counted for 10 and for
+// 1000 frequencies (each after a warm-up call of the same size); per-call selection work
+// allocates the same in both, so the counts must be equal.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+
+#include "mbsgen/runtime/frequency_response.hpp"
+#include "models.hpp"
+
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+}
+
+namespace {
+std::atomic<long> g_allocations{0};
+std::atomic<bool> g_counting{false};
+}  // namespace
+
+extern "C" void* malloc(std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) ++g_allocations;
+  return __libc_malloc(n);
+}
+extern "C" void* calloc(std::size_t a, std::size_t b) {
+  if (g_counting.load(std::memory_order_relaxed)) ++g_allocations;
+  return __libc_calloc(a, b);
+}
+extern "C" void* realloc(void* p, std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) ++g_allocations;
+  return __libc_realloc(p, n);
+}
+
+namespace {
+long allocations_of_compute(mbsgen::FrequencyResponse& f, const Eigen::VectorXd& w) {
+  g_allocations = 0;
+  g_counting = true;
+  f.compute(w, 0, {0, 3});
+  g_counting = false;
+  return g_allocations.load();
+}
+}  // namespace
+
+TEST(NoAllocation, PerFrequencyLoopOfEveryMethod) {
+  const testmodels::Qep p = testmodels::ear_chain(8, true);
+  const mbsgen::LinearModel m(p.M, p.Q, p.K);
+  Eigen::VectorXd w10 = Eigen::VectorXd::LinSpaced(10, 600.0, 1.2e5);
+  Eigen::VectorXd w1000 = Eigen::VectorXd::LinSpaced(1000, 600.0, 1.2e5);
+  for (auto meth : {mbsgen::FrfMethod::direct, mbsgen::FrfMethod::banded,
+                    mbsgen::FrfMethod::hessenberg, mbsgen::FrfMethod::modal,
+                    mbsgen::FrfMethod::real}) {
+    mbsgen::FrfOptions o;
+    o.method = meth;
+    mbsgen::FrequencyResponse f(m, o);
+    // Warm-up calls of the same size first: one-time setup (factorizations, reductions, modes)
+    // and the result arrays are then in place; what remains is per-call selection work.
+    f.compute(w10, 0, {0, 3});
+    const long a10 = allocations_of_compute(f, w10);
+    f.compute(w1000, 0, {0, 3});
+    const long a1000 = allocations_of_compute(f, w1000);
+    EXPECT_EQ(a10, a1000) << to_string(meth) << ": the loop over frequencies allocates";
+  }
+}
