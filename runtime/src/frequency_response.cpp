@@ -44,68 +44,155 @@ struct PermutedDiagonal {
   }
 };
 
-/// LU with adjacent-row partial pivoting of an upper Hessenberg W (row-major, order N), O(N²),
-/// with solves for W and Wᴴ and a 1-norm condition estimate. Workspaces allocated once.
-struct HessenbergLU {
-  RowMatrixXcd W;
-  Eigen::VectorXcd l;
+/// Solver for (iΩT − H) x = b with H upper Hessenberg and T upper triangular (or T = E), real,
+/// of order N, in O(N²) per frequency (Laub 1981): Gaussian elimination with adjacent-row
+/// partial pivoting, fused so that the matrix is streamed twice per frequency — once to form and
+/// factorize W = iΩT − H (also accumulating ‖W‖₁, eliminating the right-hand side and running the
+/// first half of the condition estimate), once for the back substitution of two right-hand
+/// sides. W is kept as separate row-major real and imaginary planes so the inner loops are plain
+/// real arithmetic the compiler vectorizes (std::complex products would call __muldc3 for C99
+/// Annex G Inf/NaN semantics; a non-finite result is caught by the caller's check). The
+/// condition estimate follows Cline, Moler, Stewart & Wilkinson (1979, LINPACK): solve Wᴴy = e
+/// choosing |e_j| = 1 during the substitution with Uᴴ so that y grows, then z = W⁻¹y, and
+/// ‖z‖₁/‖y‖₁ ≤ ‖W⁻¹‖₁ (in practice within a small factor). Workspaces are allocated once.
+struct HessenbergSolver {
+  RowMatrixXd Wr, Wi;              // U after factorization
+  Eigen::VectorXd lr, li;          // multipliers l_k (row k+1 −= l_k·row k)
   std::vector<unsigned char> swapped;
-  Eigen::VectorXcd x, xi;
+  Eigen::VectorXd er, ei, colsum;  // estimator vector, column sums of |W|
   Index N = 0;
   void resize(Index n) {
     N = n;
-    W.resize(n, n);
-    l.resize(n);
+    Wr.resize(n, n);
+    Wi.resize(n, n);
+    lr.resize(n);
+    li.resize(n);
     swapped.assign(static_cast<std::size_t>(n), 0);
-    x.resize(n);
-    xi.resize(n);
+    er.resize(n);
+    ei.resize(n);
+    colsum.resize(n);
   }
-  /// Factorizes W in place; returns false if an exact zero pivot occurs.
-  bool factorize() {
-    for (Index k = 0; k + 1 < N; ++k) {
-      const Index len = N - k;
-      cd* rk = &W(k, k);
-      cd* rk1 = &W(k + 1, k);
-      const bool sw = std::abs(*rk1) > std::abs(*rk);
-      swapped[static_cast<std::size_t>(k)] = sw;
-      if (sw)
-        for (Index j = 0; j < len; ++j) std::swap(rk[j], rk1[j]);
-      if (*rk == cd(0.0)) return false;
-      const cd lk = *rk1 / *rk;
-      l[k] = lk;
-      rk1[0] = 0.0;
-      for (Index j = 1; j < len; ++j) rk1[j] -= lk * rk[j];
+
+  /// Solves (iΩT − H)x = b for real b given in xr (xi must be zero on entry); T == nullptr
+  /// means T = E. Returns false at an exact zero pivot; rc receives the reciprocal condition
+  /// estimate 1/(‖W‖₁·est‖W⁻¹‖₁).
+  bool solve(const RowMatrixXd& H, const RowMatrixXd* T, double om, Eigen::VectorXd& xr,
+             Eigen::VectorXd& xi, double& rc) {
+    colsum.setZero();
+    er.setZero();
+    ei.setZero();
+    auto load_row = [&](Index i) {  // row i of W = iΩT − H, columns ≥ i−1
+      const Index j0 = i > 0 ? i - 1 : 0;
+      const double* hi = &H(i, 0);
+      double* wr = &Wr(i, 0);
+      double* wi = &Wi(i, 0);
+      for (Index j = j0; j < N; ++j) wr[j] = -hi[j];
+      if (T == nullptr) {
+        for (Index j = j0; j < N; ++j) wi[j] = 0.0;
+        wi[i] = om;
+      } else {
+        const double* ti = &(*T)(i, 0);
+        for (Index j = j0; j < N; ++j) wi[j] = om * ti[j];
+      }
+      for (Index j = j0; j < N; ++j) colsum[j] += std::sqrt(wr[j] * wr[j] + wi[j] * wi[j]);
+    };
+    load_row(0);
+    for (Index k = 0; k < N; ++k) {
+      double* ar = &Wr(k, 0);
+      double* ai = &Wi(k, 0);
+      if (k + 1 < N) {
+        load_row(k + 1);
+        double* br = &Wr(k + 1, 0);
+        double* bi = &Wi(k + 1, 0);
+        const bool sw = br[k] * br[k] + bi[k] * bi[k] > ar[k] * ar[k] + ai[k] * ai[k];
+        swapped[static_cast<std::size_t>(k)] = sw;
+        if (sw) {
+          for (Index j = k; j < N; ++j) {
+            std::swap(ar[j], br[j]);
+            std::swap(ai[j], bi[j]);
+          }
+          std::swap(xr[k], xr[k + 1]);
+          std::swap(xi[k], xi[k + 1]);
+        }
+        if (ar[k] == 0.0 && ai[k] == 0.0) return false;
+        const cd lk = cd(br[k], bi[k]) / cd(ar[k], ai[k]);
+        const double pr = lk.real(), pi = lk.imag();
+        lr[k] = pr;
+        li[k] = pi;
+        br[k] = 0.0;
+        bi[k] = 0.0;
+        for (Index j = k + 1; j < N; ++j) {
+          const double tr = ar[j], ti = ai[j];
+          br[j] -= pr * tr - pi * ti;
+          bi[j] -= pr * ti + pi * tr;
+        }
+        const double x0r = xr[k], x0i = xi[k];
+        xr[k + 1] -= pr * x0r - pi * x0i;
+        xi[k + 1] -= pr * x0i + pi * x0r;
+      } else if (ar[k] == 0.0 && ai[k] == 0.0) {
+        return false;
+      }
+      // Row k of U is final: step k of Uᴴv = e (column-oriented on the rows of U).
+      const double a = std::hypot(er[k], ei[k]);
+      if (a > 0) {
+        er[k] += er[k] / a;
+        ei[k] += ei[k] / a;
+      } else {
+        er[k] += 1.0;
+      }
+      const cd v = cd(er[k], ei[k]) / cd(ar[k], -ai[k]);
+      const double vr = v.real(), vi = v.imag();
+      er[k] = vr;
+      ei[k] = vi;
+      for (Index i = k + 1; i < N; ++i) {  // e_i −= conj(U_ki)·v
+        er[i] -= ar[i] * vr + ai[i] * vi;
+        ei[i] -= ar[i] * vi - ai[i] * vr;
+      }
     }
-    return W(N - 1, N - 1) != cd(0.0);
-  }
-  void solve(Eigen::VectorXcd& r) const {
-    for (Index k = 0; k + 1 < N; ++k) {
-      if (swapped[static_cast<std::size_t>(k)]) std::swap(r[k], r[k + 1]);
-      r[k + 1] -= l[k] * r[k];
-    }
-    for (Index i = N - 1; i >= 0; --i) {
-      cd s = r[i];
-      const cd* wi = &W(i, 0);
-      for (Index j = i + 1; j < N; ++j) s -= wi[j] * r[j];
-      r[i] = s / wi[i];
-    }
-  }
-  void solve_adjoint(Eigen::VectorXcd& r) const {
-    for (Index j = 0; j < N; ++j) {  // Uᴴ v = r, column-oriented on the rows of U
-      const cd* wj = &W(j, 0);
-      r[j] /= std::conj(wj[j]);
-      const cd rj = r[j];
-      for (Index i = j + 1; i < N; ++i) r[i] -= std::conj(wj[i]) * rj;
-    }
+    // Estimator: the transposed eliminations (r_k −= conj(l_k) r_{k+1}), then y = W⁻ᴴe is done;
+    // apply the forward eliminations of W⁻¹ to it.
     for (Index k = N - 2; k >= 0; --k) {
-      r[k] -= std::conj(l[k]) * r[k + 1];
-      if (swapped[static_cast<std::size_t>(k)]) std::swap(r[k], r[k + 1]);
+      er[k] -= lr[k] * er[k + 1] + li[k] * ei[k + 1];
+      ei[k] -= lr[k] * ei[k + 1] - li[k] * er[k + 1];
+      if (swapped[static_cast<std::size_t>(k)]) {
+        std::swap(er[k], er[k + 1]);
+        std::swap(ei[k], ei[k + 1]);
+      }
     }
-  }
-  double inverse_norm1() {
-    return detail::inverse_norm1_estimate(
-        N, [this](Eigen::VectorXcd& v) { solve(v); },
-        [this](Eigen::VectorXcd& v) { solve_adjoint(v); }, x, xi);
+    double ny = 0;
+    for (Index i = 0; i < N; ++i) ny += std::sqrt(er[i] * er[i] + ei[i] * ei[i]);
+    for (Index k = 0; k + 1 < N; ++k) {
+      if (swapped[static_cast<std::size_t>(k)]) {
+        std::swap(er[k], er[k + 1]);
+        std::swap(ei[k], ei[k + 1]);
+      }
+      er[k + 1] -= lr[k] * er[k] - li[k] * ei[k];
+      ei[k + 1] -= lr[k] * ei[k] + li[k] * er[k];
+    }
+    // Back substitution with U for both right-hand sides in one pass.
+    for (Index i = N - 1; i >= 0; --i) {
+      const double* ur = &Wr(i, 0);
+      const double* ui = &Wi(i, 0);
+      double sr = xr[i], si = xi[i], tr = er[i], ti = ei[i];
+      for (Index j = i + 1; j < N; ++j) {
+        sr -= ur[j] * xr[j] - ui[j] * xi[j];
+        si -= ur[j] * xi[j] + ui[j] * xr[j];
+        tr -= ur[j] * er[j] - ui[j] * ei[j];
+        ti -= ur[j] * ei[j] + ui[j] * er[j];
+      }
+      const cd d(ur[i], ui[i]);
+      const cd v = cd(sr, si) / d, w = cd(tr, ti) / d;
+      xr[i] = v.real();
+      xi[i] = v.imag();
+      er[i] = w.real();
+      ei[i] = w.imag();
+    }
+    double nz = 0;
+    for (Index i = 0; i < N; ++i) nz += std::sqrt(er[i] * er[i] + ei[i] * ei[i]);
+    const double anorm = colsum.maxCoeff();
+    const double inv = ny > 0 ? nz / ny : std::numeric_limits<double>::infinity();
+    rc = (anorm > 0 && inv > 0 && std::isfinite(inv)) ? 1.0 / (anorm * inv) : 0.0;
+    return true;
   }
 };
 
@@ -271,9 +358,8 @@ struct FrequencyResponse::Impl {
   Eigen::MatrixXd qr_E;              // pencil form: QR factors of the balanced E
   Eigen::VectorXd qr_tau;
   PermutedDiagonal Xl, Xr;           // balancing: Ã = Xlᵀ A Xr, x = Xr x̃
-  HessenbergLU hlu;
-  Eigen::VectorXcd hrhs;             // reduced right-hand side r̃ (N)
-  Eigen::MatrixXcd Chat;             // p×N reduced outputs
+  HessenbergSolver hsolver;
+  Eigen::MatrixXd Chat_re;           // p×N reduced outputs (real)
   std::string hess_form;
 
   /// LU of M exists (no zero pivot) and its 1-norm rcond estimate is at least `threshold`.
@@ -362,8 +448,9 @@ struct FrequencyResponse::Impl {
         for (Index i = j + 2; i < N; ++i) H(i, j) = 0.0;
       T = R.triangularView<Eigen::Upper>();
     }
-    hlu.resize(N);
-    hrhs.resize(N);
+    hsolver.resize(N);
+    xr_ws.resize(N);
+    xi_ws.resize(N);
     hess_ready = true;
   }
 
@@ -398,44 +485,27 @@ struct FrequencyResponse::Impl {
       r = Qleft.transpose() * r;
       Ct = Zright.transpose() * Ct;
     }
-    hrhs.resize(N);
-    Chat = Ct.transpose().cast<cd>();
+    Chat_re = Ct.transpose();
     rhs_reduced = r;
+    zr_ws.resize(p);
+    zi_ws.resize(p);
   }
   Eigen::VectorXd rhs_reduced;
 
   bool point_hessenberg(double om, double& rc) {
-    const cd s(0.0, om);
-    RowMatrixXcd& W = hlu.W;
-    Eigen::VectorXd& colsum = colsum_ws;
-    colsum.setZero(N);
-    for (Index i = 0; i < N; ++i) {
-      const Index j0 = i > 0 ? i - 1 : 0;
-      const double* hi = &H(i, 0);
-      cd* wi = &W(i, 0);
-      for (Index j = 0; j < j0; ++j) wi[j] = 0.0;
-      if (hess_standard) {
-        for (Index j = j0; j < N; ++j) wi[j] = -hi[j];
-        wi[i] += s;
-      } else {
-        const double* ti = &T(i, 0);
-        for (Index j = j0; j < N; ++j) wi[j] = cd(-hi[j], om * ti[j]);
-      }
-      for (Index j = j0; j < N; ++j) colsum[j] += std::abs(wi[j]);
-    }
-    const double anorm = colsum.maxCoeff();
-    if (!hlu.factorize()) {
+    xr_ws = rhs_reduced;
+    xi_ws.setZero();
+    if (!hsolver.solve(H, hess_standard ? nullptr : &T, om, xr_ws, xi_ws, rc)) {
       rc = 0.0;
       return false;
     }
-    const double inv = hlu.inverse_norm1();
-    rc = (anorm > 0 && inv > 0) ? 1.0 / (anorm * inv) : 0.0;
-    for (Index i = 0; i < N; ++i) hrhs[i] = rhs_reduced[i];
-    hlu.solve(hrhs);
-    z.noalias() = Chat * hrhs;
+    zr_ws.noalias() = Chat_re * xr_ws;
+    zi_ws.noalias() = Chat_re * xi_ws;
+    z.real() = zr_ws;
+    z.imag() = zi_ws;
     return true;
   }
-  Eigen::VectorXd colsum_ws;
+  Eigen::VectorXd xr_ws, xi_ws, zr_ws, zi_ws;
 
   // ---- modal ----
   bool modal_ready = false;
@@ -665,7 +735,6 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
     case FrfMethod::hessenberg:
       im.prepare_hessenberg(options_.hessenberg_mass_rcond, options_.balance);
       im.select_hessenberg();
-      im.colsum_ws.resize(im.N);
       break;
     case FrfMethod::modal:
       im.prepare_modal(options_, warnings_);

@@ -80,9 +80,10 @@ struct FrfOptions {
 /// reductions, modes) happens once, on the first compute() with that method; the loop over
 /// frequencies does not allocate.
 ///
-/// Every frequency carries a reciprocal condition estimate rcond (1-norm, Higham's estimator as
-/// in LAPACK xGECON) of the matrix actually solved: K − Ω²M + iΩQ (direct, banded), the reduced
-/// Hessenberg matrix iΩT − H of the balanced first-order pencil (hessenberg), Ω²E + A² (real);
+/// Every frequency carries a reciprocal condition estimate rcond (1-norm) of the matrix actually
+/// solved: K − Ω²M + iΩQ (direct, banded: LAPACK xGECON/xGBCON, Higham's estimator), the reduced
+/// Hessenberg matrix iΩT − H of the balanced first-order system (hessenberg: the two-solve
+/// LINPACK estimator of Cline, Moler, Stewart & Wilkinson 1979), Ω²E + A² (real: dgecon);
 /// for modal a spectral estimate min_k |iΩ − λ_k|/max(|λ_k|,Ω) divided by the eigenvector
 /// condition. Amplitude |ẑ| and phase lag Ψ = −arg ẑ = atan2(−Im ẑ, Re ẑ), so that
 /// z(t) = |ẑ| cos(Ωt − Ψ) (eqs. 3.21-3.23 with the quadrant kept).
