@@ -531,9 +531,12 @@ struct FrequencyResponse::Impl {
       Eigen::MatrixXcd V(2 * n, nm);
       dk.resize(nm);
       const Eigen::MatrixXcd Mc = model.M().cast<cd>(), Qc = model.Q().cast<cd>();
+      // Eigenvector matrix of the linearization in the scaled variable μ = λ/γ, so that the
+      // estimate measures near-defectiveness rather than the spread of |λ|.
+      const double gamma = es.gamma();
       for (Index k = 0; k < nm; ++k) {
         const Mode& m = modes[static_cast<std::size_t>(k)];
-        V.col(k) << m.shape, m.lambda * m.shape;
+        V.col(k) << m.shape, (m.lambda / gamma) * m.shape;
         V.col(k).normalize();
         dk[k] = m.left_shape.dot(2.0 * m.lambda * (Mc * m.shape) + Qc * m.shape);
       }
@@ -545,7 +548,7 @@ struct FrequencyResponse::Impl {
       std::ostringstream s;
       s << "FrequencyResponse (modal): eigenvector matrix condition estimate " << eigvec_condition
         << " exceeds " << opt.modal_max_condition
-        << " (near-defective eigenvalues); the modal sum is unreliable: use direct";
+        << " (ill-conditioned eigenvectors, e.g. near-defective eigenvalues); the modal sum is unreliable: use direct";
       if (!opt.modal_allow_ill_conditioned) throw IllConditionedError(s.str());
       warnings.push_back(s.str());
     }
@@ -594,6 +597,7 @@ struct FrequencyResponse::Impl {
     const cd s(0.0, om);
     z = zstatic_y + s * zstatic_v;
     double dmin = std::numeric_limits<double>::infinity();
+    double terms = z.norm();
     for (Index k = 0; k < lam.size(); ++k) {
       const cd d = s - lam[k];
       dmin = std::min(dmin, std::abs(d) / std::max(std::abs(lam[k]), om));
@@ -603,8 +607,13 @@ struct FrequencyResponse::Impl {
       }
       const cd w = coef[k] / d;
       z += w * (CX.col(k) + s * CVX.col(k));
+      terms += std::abs(w) * (CX.col(k) + s * CVX.col(k)).norm();
     }
-    rc = dmin / eigvec_condition;
+    // Relative distance to the nearest pole (eigenvalues carry errors ~u|λ|) and cancellation in
+    // the sum (rounding errors of the terms relative to the result), whichever is worse, divided
+    // by the eigenvector condition (errors of the computed eigenvectors).
+    const double cancellation = terms > 0 ? z.norm() / terms : 1.0;
+    rc = std::min(dmin, cancellation) / std::max(1.0, eigvec_condition);
     return true;
   }
 

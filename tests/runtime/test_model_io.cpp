@@ -1,6 +1,9 @@
 // LinearModel validation and Matrix Market I/O.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "mbsgen/runtime/linear_model.hpp"
@@ -110,4 +113,26 @@ TEST(MatrixMarket, ErrorsCarryFileAndLine) {
   std::istringstream nan("%%MatrixMarket matrix array real general\n1 1\nnan\n");
   EXPECT_THROW(mbsgen::read_matrix_market(nan, "n"), mbsgen::NonFiniteError);
   EXPECT_THROW(mbsgen::read_matrix_market("/nonexistent/file.mtx"), mbsgen::ParseError);
+}
+
+TEST(RuntimeSources, NeverIncludeGinac) {
+  // DESIGN.md: the runtime never depends on GiNaC (nor CLN, which only the tests use).
+  namespace fs = std::filesystem;
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(std::string(MBSGEN_SOURCE_DIR) + "/runtime")) {
+    if (!e.is_regular_file()) continue;
+    std::ifstream in(e.path());
+    std::string line;
+    ++files;
+    while (std::getline(in, line)) {
+      std::string l = line;
+      for (char& c : l) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      const bool include = l.find("#include") != std::string::npos;
+      EXPECT_FALSE(include && (l.find("ginac") != std::string::npos || l.find("cln/") != std::string::npos))
+          << e.path() << ": " << line;
+      EXPECT_FALSE(l.find("target_link_libraries") != std::string::npos && l.find("ginac") != std::string::npos)
+          << e.path() << ": " << line;
+    }
+  }
+  EXPECT_GT(files, 10);
 }

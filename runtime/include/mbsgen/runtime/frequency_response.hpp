@@ -59,8 +59,10 @@ struct FrfOptions {
   Eigen::Index modal_modes = 0;
   /// modal with truncation: add the static (residual) correction K⁻¹b − Σ_kept (needs K regular).
   bool static_correction = true;
-  /// modal: refuse (IllConditionedError) when the 1-norm condition estimate κ of the normalized
-  /// eigenvector matrix of the linearization exceeds this, unless modal_allow_ill_conditioned.
+  /// modal: refuse (IllConditionedError) when the 1-norm condition estimate κ of the
+  /// column-normalized eigenvector matrix [x_k; (λ_k/γ)x_k] of the linearization (γ the
+  /// eigenvalue scaling of QuadraticEigenSolver) exceeds this, unless
+  /// modal_allow_ill_conditioned.
   /// The modal sum loses about log10(κ) digits; 1e6 keeps about 10 (a defective pair, split by
   /// O(√u) in floating point, has κ ≈ 1e8).
   double modal_max_condition = 1e6;
@@ -84,8 +86,8 @@ struct FrfOptions {
 /// solved: K − Ω²M + iΩQ (direct, banded: LAPACK xGECON/xGBCON, Higham's estimator), the reduced
 /// Hessenberg matrix iΩT − H of the balanced first-order system (hessenberg: the two-solve
 /// LINPACK estimator of Cline, Moler, Stewart & Wilkinson 1979), Ω²E + A² (real: dgecon);
-/// for modal a spectral estimate min_k |iΩ − λ_k|/max(|λ_k|,Ω) divided by the eigenvector
-/// condition. Amplitude |ẑ| and phase lag Ψ = −arg ẑ = atan2(−Im ẑ, Re ẑ), so that
+/// for modal min(min_k |iΩ − λ_k|/max(|λ_k|, Ω), ‖ẑ‖/Σ_k‖term_k‖)/κ: the relative distance to
+/// the nearest pole and the cancellation in the modal sum, divided by the eigenvector condition κ. Amplitude |ẑ| and phase lag Ψ = −arg ẑ = atan2(−Im ẑ, Re ẑ), so that
 /// z(t) = |ẑ| cos(Ωt − Ψ) (eqs. 3.21-3.23 with the quadrant kept).
 class FrequencyResponse {
  public:
