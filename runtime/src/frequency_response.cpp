@@ -116,10 +116,13 @@ struct HessenbergSolver {
     for (Index k = 0; k < N; ++k) {
       double* ar = &Wr(k, 0);
       double* ai = &Wi(k, 0);
+      double* br = nullptr;
+      double* bi = nullptr;
+      double pr = 0.0, pi = 0.0;
       if (k + 1 < N) {
         load_row(k + 1);
-        double* br = &Wr(k + 1, 0);
-        double* bi = &Wi(k + 1, 0);
+        br = &Wr(k + 1, 0);
+        bi = &Wi(k + 1, 0);
         const bool sw = br[k] * br[k] + bi[k] * bi[k] > ar[k] * ar[k] + ai[k] * ai[k];
         swapped[static_cast<std::size_t>(k)] = sw;
         if (sw) {
@@ -130,25 +133,23 @@ struct HessenbergSolver {
           std::swap(xr[k], xr[k + 1]);
           std::swap(xi[k], xi[k + 1]);
         }
-        if (ar[k] == 0.0 && ai[k] == 0.0) return false;
-        const cd lk = mul(cd(br[k], bi[k]), reciprocal(ar[k], ai[k]));
-        const double pr = lk.real(), pi = lk.imag();
+      }
+      if (ar[k] == 0.0 && ai[k] == 0.0) return false;
+      rpiv[k] = reciprocal(ar[k], ai[k]);
+      if (k + 1 < N) {
+        const cd lk = mul(cd(br[k], bi[k]), rpiv[k]);
+        pr = lk.real();
+        pi = lk.imag();
         lr[k] = pr;
         li[k] = pi;
         br[k] = 0.0;
         bi[k] = 0.0;
-        for (Index j = k + 1; j < N; ++j) {
-          const double tr = ar[j], ti = ai[j];
-          br[j] -= pr * tr - pi * ti;
-          bi[j] -= pr * ti + pi * tr;
-        }
         const double x0r = xr[k], x0i = xi[k];
         xr[k + 1] -= pr * x0r - pi * x0i;
         xi[k + 1] -= pr * x0i + pi * x0r;
-      } else if (ar[k] == 0.0 && ai[k] == 0.0) {
-        return false;
       }
-      // Row k of U is final: step k of Uᴴv = e (column-oriented on the rows of U).
+      // Row k of U is final: step k of Uᴴv = e (column-oriented on the rows of U), fused with
+      // the elimination of row k+1 so that row k is read once.
       const double a = std::hypot(er[k], ei[k]);
       if (a > 0) {
         er[k] += er[k] / a;
@@ -156,14 +157,18 @@ struct HessenbergSolver {
       } else {
         er[k] += 1.0;
       }
-      rpiv[k] = reciprocal(ar[k], ai[k]);
       const cd v = mul(cd(er[k], ei[k]), std::conj(rpiv[k]));
       const double vr = v.real(), vi = v.imag();
       er[k] = vr;
       ei[k] = vi;
-      for (Index i = k + 1; i < N; ++i) {  // e_i −= conj(U_ki)·v
-        er[i] -= ar[i] * vr + ai[i] * vi;
-        ei[i] -= ar[i] * vi - ai[i] * vr;
+      if (k + 1 < N) {
+        for (Index j = k + 1; j < N; ++j) {
+          const double tr = ar[j], ti = ai[j];
+          br[j] -= pr * tr - pi * ti;
+          bi[j] -= pr * ti + pi * tr;
+          er[j] -= tr * vr + ti * vi;  // e_j −= conj(U_kj)·v
+          ei[j] -= tr * vi - ti * vr;
+        }
       }
     }
     // Estimator: the transposed eliminations (r_k −= conj(l_k) r_{k+1}), then y = W⁻ᴴe is done;

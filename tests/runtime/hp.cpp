@@ -1,5 +1,6 @@
 #include "hp.hpp"
 
+#include <limits>
 #include <stdexcept>
 
 namespace hp {
@@ -172,7 +173,9 @@ double backward_error(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q, const 
     cached_n = n;
   }
   const double den = (aa * aa * nM + aa * beta * nQ + beta * beta * nK) * x.norm();
-  return to_double(vnorm(r)) / den;
+  const double num = to_double(vnorm(r));
+  if (den == 0.0) return num == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();  // 0/0: exact
+  return num / den;
 }
 
 std::complex<double> refine_eigenvalue(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,

@@ -371,3 +371,39 @@ TEST(Modes, InvalidInputThrows) {
   K(0, 1) = std::nan("");
   EXPECT_THROW(s.compute(Eigen::MatrixXd::Identity(2, 2), Eigen::MatrixXd(), K), mbsgen::NonFiniteError);
 }
+
+TEST(Modes, DegenerateCoefficients) {
+  // M = 0 (a first-order system Q ẏ + K y = 0): λ = −1, −2 and two infinite eigenvalues.
+  {
+    Qep p{Eigen::MatrixXd::Zero(2, 2), Eigen::MatrixXd::Identity(2, 2), Eigen::MatrixXd(2, 2)};
+    p.K << 1, 0, 0, 2;
+    QuadraticEigenSolver s(2);
+    s.compute(p.M, p.Q, p.K);
+    EXPECT_EQ(count(s, EigenvalueKind::infinite), 2);
+    ASSERT_EQ(count(s, EigenvalueKind::finite), 2);
+    EXPECT_NEAR(s.modes()[0].lambda.real(), -1.0, 1e-15);  // exact data: a few u
+    EXPECT_NEAR(s.modes()[1].lambda.real(), -2.0, 2e-15);
+    expect_backward_stable(p, s);
+  }
+  // K = 0, Q = 0: every eigenvalue is zero (free masses), on both paths.
+  for (bool fast : {true, false}) {
+    const Qep p{Eigen::MatrixXd::Identity(3, 3), Eigen::MatrixXd::Zero(3, 3), Eigen::MatrixXd::Zero(3, 3)};
+    QuadraticEigenOptions o;
+    o.symmetric_fast_path = fast;
+    QuadraticEigenSolver s(3, o);
+    s.compute(p.M, p.Q, p.K);
+    EXPECT_EQ(count(s, EigenvalueKind::zero), 6) << s.method();
+    expect_backward_stable(p, s);
+  }
+  // One coordinate: m = 1, k = 4 → λ = ±2i exactly representable.
+  {
+    const Qep p{Eigen::MatrixXd::Constant(1, 1, 1.0), Eigen::MatrixXd::Zero(1, 1),
+                Eigen::MatrixXd::Constant(1, 1, 4.0)};
+    QuadraticEigenSolver s(1);
+    s.compute(p.M, p.Q, p.K);
+    ASSERT_EQ(s.modes().size(), 2u);
+    EXPECT_EQ(s.modes()[0].lambda, cd(0.0, 2.0));
+    EXPECT_EQ(s.modes()[1].lambda, cd(0.0, -2.0));
+    EXPECT_NEAR(s.modes()[0].natural_frequency_hz, 2.0 / (2 * M_PI), 1e-16);
+  }
+}
