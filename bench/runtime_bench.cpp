@@ -158,7 +158,7 @@ void register_all() {
         ->Args({n, fdirect})->Unit(benchmark::kMillisecond)->Iterations(n >= 200 ? 1 : 3);
     benchmark::RegisterBenchmark(("frf/hessenberg/n=" + std::to_string(n)).c_str(), BM_frf,
                                  FrfMethod::hessenberg, true)
-        ->Args({n, 1000})->Unit(benchmark::kMillisecond)->Iterations(n >= 200 ? 1 : 3);
+        ->Args({n, 1000})->Unit(benchmark::kMillisecond)->Iterations(n >= 1000 ? 1 : 3);
     benchmark::RegisterBenchmark(("frf/banded/n=" + std::to_string(n)).c_str(), BM_frf,
                                  FrfMethod::banded, true)
         ->Args({n, 1000})->Unit(benchmark::kMillisecond)->Iterations(3);
