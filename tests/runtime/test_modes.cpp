@@ -121,6 +121,7 @@ TEST(Modes, MasslessCoordinateGivesInfiniteEigenvalues) {
   for (const Mode& m : s.modes())
     if (m.kind == EigenvalueKind::infinite) {
       // The infinite eigenvector spans the null space of M: |x_3| = 1.
+      // |x_3| = 1 up to the O(√u) perturbation of the Jordan block at ∞
       EXPECT_NEAR(std::abs(m.shape[2]), 1.0, 1e-8);
       EXPECT_TRUE(std::isinf(m.natural_frequency_hz));
     }
@@ -158,9 +159,10 @@ TEST(Modes, FreeFreeChainReportsRigidBodyModeAsZero) {
       for (const Mode& md : s.modes()) {
         if (md.kind == EigenvalueKind::zero) {
           // rigid-body shape: all coordinates equal, 1/√6 each
+          // equal entries up to the O(√u) perturbation of the Jordan block at 0
           for (Eigen::Index i = 0; i < 6; ++i) EXPECT_NEAR(std::abs(md.shape[i]), 1 / std::sqrt(6.0), 1e-8);
         } else {
-          EXPECT_GT(std::abs(md.lambda), 1e3);  // no spurious near-zero "finite" eigenvalue
+          EXPECT_GT(std::abs(md.lambda), 1e3);  // no spurious near-zero "finite" eigenvalue (elastic modes are above 1e3 rad/s)
         }
       }
       expect_accurate(p, s);
@@ -327,7 +329,7 @@ TEST(Modes, OnePerConjugatePair) {
   for (const Mode& m : s.modes()) EXPECT_GT(m.lambda.imag(), 0.0);
   // normalization convention: unit 2-norm, largest entry real positive
   for (const Mode& m : s.modes()) {
-    EXPECT_NEAR(m.shape.norm(), 1.0, 1e-14);
+    EXPECT_NEAR(m.shape.norm(), 1.0, 1e-14);  // normalized in double: a few u
     Eigen::Index i = 0;
     m.shape.cwiseAbs().maxCoeff(&i);
     EXPECT_EQ(m.shape[i].imag(), 0.0);
@@ -382,7 +384,7 @@ TEST(Modes, DegenerateCoefficients) {
     EXPECT_EQ(count(s, EigenvalueKind::infinite), 2);
     ASSERT_EQ(count(s, EigenvalueKind::finite), 2);
     EXPECT_NEAR(s.modes()[0].lambda.real(), -1.0, 1e-15);  // exact data: a few u
-    EXPECT_NEAR(s.modes()[1].lambda.real(), -2.0, 2e-15);
+    EXPECT_NEAR(s.modes()[1].lambda.real(), -2.0, 2e-15);  // same, |λ| = 2
     expect_backward_stable(p, s);
   }
   // K = 0, Q = 0: every eigenvalue is zero (free masses), on both paths.
@@ -404,6 +406,6 @@ TEST(Modes, DegenerateCoefficients) {
     ASSERT_EQ(s.modes().size(), 2u);
     EXPECT_EQ(s.modes()[0].lambda, cd(0.0, 2.0));
     EXPECT_EQ(s.modes()[1].lambda, cd(0.0, -2.0));
-    EXPECT_NEAR(s.modes()[0].natural_frequency_hz, 2.0 / (2 * M_PI), 1e-16);
+    EXPECT_NEAR(s.modes()[0].natural_frequency_hz, 2.0 / (2 * M_PI), 1e-16);  // one rounding
   }
 }
