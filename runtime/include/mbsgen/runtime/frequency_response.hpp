@@ -18,7 +18,7 @@ namespace mbsgen {
 enum class FrfMethod {
   automatic,   ///< banded for narrow-band models, hessenberg for many frequencies, else direct
   direct,      ///< complex LU (zgetrf) of K − Ω²M + iΩQ per frequency, O(f³) each: the reference
-  banded,      ///< complex band LU (zgbtrf) of the same matrix, O(f·b²) each (chains, FE models)
+  banded,      ///< complex band LU of the same matrix, O(f·b²) each (chains, FE models)
   hessenberg,  ///< one-time Hessenberg(-triangular) reduction, then O(f²) per frequency (Laub 1981)
   modal,       ///< superposition of the modes with static correction (needs M nonsingular)
   real         ///< DESIGN.md's corrected real formulation (Ω²E + A²)g = −A b, −Ω b (comparison)
@@ -91,8 +91,9 @@ struct FrfOptions {
 /// z(t) = |ẑ| cos(Ωt − Ψ) (eqs. 3.21-3.23 with the quadrant kept).
 class FrequencyResponse {
  public:
+  /// Keeps a reference to `model` (f coordinates) and the options; allocates nothing large yet.
   explicit FrequencyResponse(const LinearModel& model, FrfOptions options = {});
-  ~FrequencyResponse();
+  ~FrequencyResponse();  ///< defined where Impl is complete
   FrequencyResponse(const FrequencyResponse&) = delete;
   FrequencyResponse& operator=(const FrequencyResponse&) = delete;
 
@@ -103,6 +104,7 @@ class FrequencyResponse {
   FrequencyResponse& compute(const Eigen::VectorXd& omega, Eigen::Index input,
                              const std::vector<Eigen::Index>& outputs = {});
 
+  /// Eigen::Success after a completed compute() (flagged points included).
   Eigen::ComputationInfo info() const { return info_; }
   /// The method used (never automatic after compute()).
   FrfMethod method() const { return used_; }
@@ -116,9 +118,8 @@ class FrequencyResponse {
   /// Warnings recorded by the last compute() (e.g. modal without static correction).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
-  struct Impl;
-
  private:
+  struct Impl;  // per-method workspaces (frequency_response.cpp)
   const LinearModel& model_;
   FrfOptions options_;
   std::unique_ptr<Impl> impl_;
