@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
@@ -46,23 +45,15 @@ class CppPrinter {
     std::string s = term(e, negative);
     if (negative) {
       ++operations;
-      return "-" + wrap_if_sum(e, s);
+      return "-" + (is_sum(e) ? "(" + s + ")" : s);
     }
     return s;
   }
 
  private:
   static bool is_sum(const ex& e) { return is_a<GiNaC::add>(e); }
-  std::string wrap_if_sum(const ex& e, const std::string& s) {
-    ex a = e;
-    if (is_a<GiNaC::mul>(e)) return s;  // products bind tighter than unary minus
-    return is_sum(a) ? "(" + s + ")" : s;
-  }
-
   std::string number(const GiNaC::numeric& n) {
     if (!n.is_real()) throw std::runtime_error("mbsgen: complex number in generated code");
-    if (n.is_integer() && GiNaC::abs(n) < GiNaC::numeric(1L << 53))
-      return format_double(n.to_double());
     return format_double(n.to_double());
   }
 

@@ -105,12 +105,18 @@ ex Program::define_node(const ex& e) {
   return t;
 }
 
-bool Program::depends_on(const ex& e, const GiNaC::symbol& x) {
+std::size_t Program::variable(const GiNaC::symbol& x, const char* caller) const {
   auto v = variable_index_.find(x);
   if (v == variable_index_.end())
-    throw std::logic_error("mbsgen::Program::depends_on: not a registered variable: " + x.get_name());
+    throw std::logic_error(std::string("mbsgen::Program::") + caller +
+                           ": not a registered variable: " + x.get_name());
+  return v->second;
+}
+
+bool Program::depends_on(const ex& e, const GiNaC::symbol& x) {
+  const std::size_t var = variable(x, "depends_on");
   Bits b = dependencies(e);
-  return (b[v->second / 64] >> (v->second % 64)) & 1u;
+  return (b[var / 64] >> (var % 64)) & 1u;
 }
 
 ex Program::diff_intermediate(std::size_t k, std::size_t variable) {
@@ -124,10 +130,7 @@ ex Program::diff_intermediate(std::size_t k, std::size_t variable) {
 }
 
 ex Program::diff(const ex& e, const GiNaC::symbol& x) {
-  auto v = variable_index_.find(x);
-  if (v == variable_index_.end())
-    throw std::logic_error("mbsgen::Program::diff: not a registered variable: " + x.get_name());
-  const std::size_t var = v->second;
+  const std::size_t var = variable(x, "diff");
   if (is_a<GiNaC::symbol>(e)) {
     if (e.is_equal(x)) return 1;
     if (auto d = def_index_.find(e); d != def_index_.end()) return diff_intermediate(d->second, var);

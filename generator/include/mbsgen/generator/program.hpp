@@ -62,6 +62,7 @@ class Program {
  private:
   using Bits = std::vector<std::uint64_t>;
   Bits dependencies(const GiNaC::ex& e) const;
+  std::size_t variable(const GiNaC::symbol& x, const char* caller) const;
   void collect_intermediates(const GiNaC::ex& e, std::vector<std::size_t>& out) const;
   GiNaC::ex intern_functions(const GiNaC::ex& e);
   GiNaC::ex define_node(const GiNaC::ex& e);
