@@ -1,6 +1,7 @@
 // Generation benchmark (issue 2 §7): time to derive, linearize and emit the N-link planar and
 // spatial chains, and the operation counts of the emitted kernels. Reports the median of
 // several runs. Usage: generation_bench [max_planar_n] [max_spatial_n] [repeats]
+//        generation_bench --emit DIR   writes the planar 10-link chain's kernels (for kernel_timing)
 #include "mbsgen/generator/chain.hpp"
 #include "mbsgen/generator/emit.hpp"
 
@@ -37,6 +38,15 @@ std::size_t ops(const mbsgen::GeneratedCode& code, const std::string& kernel) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--emit") {
+    mbsgen::Model model = mbsgen::planar_chain(10);
+    mbsgen::Equations eq = mbsgen::derive(model);
+    mbsgen::LinearEquations lin = mbsgen::linearize(eq);
+    mbsgen::EmitOptions options;
+    options.id = "planar_chain_10";
+    mbsgen::write_generated(mbsgen::emit(model, eq, lin, options), argv[2]);
+    return 0;
+  }
   const int max_planar = argc > 1 ? std::stoi(argv[1]) : 40;
   const int max_spatial = argc > 2 ? std::stoi(argv[2]) : 40;
   const int repeats = argc > 3 ? std::stoi(argv[3]) : 3;

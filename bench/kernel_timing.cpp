@@ -1,6 +1,6 @@
 // Evaluation time of a generated `linear` kernel (M, Q, K, B, C): median over batches of
-// repeated calls. Build against a generated planar_chain_10.cpp, e.g. (bench/README or note):
-//   g++ -O2 -I GEN bench/kernel_timing.cpp GEN/planar_chain_10.cpp -o kernel_timing
+// repeated calls. Built by bench/CMakeLists.txt against the planar_chain_10 kernels that
+// `generation_bench --emit` writes.
 #include "planar_chain_10.hpp"
 
 #include <algorithm>

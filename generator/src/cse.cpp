@@ -16,53 +16,73 @@ bool trivial(const ex& e) {
          GiNaC::is_a<GiNaC::symbol>(e.op(0));
 }
 
+using ExMap = std::unordered_map<ex, ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
 using Counts = std::unordered_map<ex, int, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
 
-void count(const ex& e, Counts& counts) {
+// Counts occurrences by representative, so that e and −e are one subexpression.
+void count(const ex& e, Counts& counts, CanonicalOrder& order) {
   if (trivial(e)) return;
-  int& c = counts[e];
+  int& c = counts[order.representative(e)];
   if (++c > 1) return;  // its children are counted once: they will be inside the temporary
-  for (std::size_t i = 0; i < e.nops(); ++i) count(e.op(i), counts);
+  for (std::size_t i = 0; i < e.nops(); ++i) count(e.op(i), counts, order);
 }
 
 struct Rewriter : GiNaC::map_function {
   const Counts& counts;
-  std::unordered_map<ex, ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> replaced;
+  CanonicalOrder& order;
+  ExMap replaced;  // representative -> temporary
+  ExMap visited;   // expression -> rewritten expression
   std::vector<Statement>* out = nullptr;
   int next = 0;
 
-  explicit Rewriter(const Counts& c) : counts(c) {}
+  Rewriter(const Counts& c, CanonicalOrder& o) : counts(c), order(o) {}
+
+  // Children in canonical order, so that temporaries are numbered independently of GiNaC's order.
+  ex map_children(const ex& e) {
+    if (e.nops() == 0) return e;
+    for (const ex& child : order.operands(e)) (*this)(child);
+    return e.map(*this);
+  }
 
   ex operator()(const ex& e) override {
     if (trivial(e)) return e;
-    if (auto it = replaced.find(e); it != replaced.end()) return it->second;
-    ex mapped = e.nops() > 0 ? e.map(*this) : e;
-    auto c = counts.find(e);
-    if (c != counts.end() && c->second > 1) {
+    if (auto it = visited.find(e); it != visited.end()) return it->second;
+    const int sign = order.sign(e);
+    const ex rep = sign > 0 ? e : ex(-e);
+    ex result;
+    if (auto it = replaced.find(rep); it != replaced.end()) {
+      result = sign * it->second;
+    } else if (auto c = counts.find(rep); c != counts.end() && c->second > 1) {
+      ex mapped = map_children(rep);
       GiNaC::symbol tmp("c" + std::to_string(next++));
+      order.set_sign(tmp, order.sign(mapped));
       out->push_back({tmp.get_name(), mapped, true, tmp});
-      replaced.emplace(e, tmp);
-      return tmp;
+      replaced.emplace(rep, tmp);
+      result = sign * tmp;
+    } else {
+      result = map_children(e);
     }
-    return mapped;
+    visited.emplace(e, result);
+    return result;
   }
 };
 
 }  // namespace
 
-std::vector<Statement> eliminate_common_subexpressions(const std::vector<Statement>& in) {
+std::vector<Statement> eliminate_common_subexpressions(const std::vector<Statement>& in,
+                                                       CanonicalOrder& order) {
   Counts counts;
   for (const auto& s : in) {
     // The top of a statement is computed once anyway; count only its parts.
     if (trivial(s.value)) continue;
-    for (std::size_t i = 0; i < s.value.nops(); ++i) count(s.value.op(i), counts);
+    for (std::size_t i = 0; i < s.value.nops(); ++i) count(s.value.op(i), counts, order);
   }
   std::vector<Statement> out;
   out.reserve(in.size());
-  Rewriter rewrite(counts);
+  Rewriter rewrite(counts, order);
   rewrite.out = &out;
   for (const auto& s : in) {
-    ex v = trivial(s.value) || s.value.nops() == 0 ? s.value : s.value.map(rewrite);
+    ex v = trivial(s.value) ? s.value : rewrite.map_children(s.value);
     out.push_back({s.target, v, s.temporary, s.symbol});
   }
   return out;

@@ -1,5 +1,6 @@
 #include "mbsgen/generator/emit.hpp"
 
+#include "mbsgen/generator/canonical.hpp"
 #include "mbsgen/generator/cse.hpp"
 
 #include <cmath>
@@ -34,9 +35,13 @@ std::string format_double(double v) {
   return s;
 }
 
-// Prints GiNaC expressions as C++ and counts the operations it writes.
+// Prints GiNaC expressions as C++ in canonical form (see canonical.hpp) and counts the
+// operations it writes. A symbol's C++ variable holds its canonical value, so a symbol whose
+// sign is −1 prints as a negated term.
 class CppPrinter {
  public:
+  explicit CppPrinter(CanonicalOrder& order) : order_(order) {}
+
   std::unordered_map<ex, std::string, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> names;
   std::size_t operations = 0;
 
@@ -50,18 +55,13 @@ class CppPrinter {
     return s;
   }
 
- private:
-  static bool is_sum(const ex& e) { return is_a<GiNaC::add>(e); }
-  std::string number(const GiNaC::numeric& n) {
-    if (!n.is_real()) throw std::runtime_error("mbsgen: complex number in generated code");
-    return format_double(n.to_double());
-  }
-
-  // Prints e without its sign when it is a negative number or a product with a negative
-  // coefficient; sets negative accordingly.
+  // Prints e without its sign; sets negative when e is minus the printed text.
   std::string term(const ex& e, bool& negative) {
     negative = false;
-    if (auto it = names.find(e); it != names.end()) return it->second;
+    if (auto it = names.find(e); it != names.end()) {
+      negative = order_.sign(e) < 0;
+      return it->second;
+    }
     if (is_a<GiNaC::numeric>(e)) {
       GiNaC::numeric n = ex_to<GiNaC::numeric>(e);
       if (n.is_negative()) {
@@ -75,40 +75,38 @@ class CppPrinter {
       throw std::runtime_error("mbsgen: unbound symbol in generated code: " +
                                ex_to<GiNaC::symbol>(e).get_name());
     if (is_a<GiNaC::add>(e)) {
-      std::string s;
-      for (std::size_t i = 0; i < e.nops(); ++i) {
+      const std::vector<ex> ops = order_.operands(e);
+      std::vector<std::pair<std::string, bool>> terms;
+      for (const ex& op : ops) {
         bool neg = false;
-        std::string t = term(e.op(i), neg);
-        if (is_sum(e.op(i))) t = "(" + t + ")";
-        if (i == 0) {
-          if (neg) ++operations;
-          s = neg ? "-" + t : t;
-        } else {
-          ++operations;
-          s += neg ? " - " + t : " + " + t;
-        }
+        std::string t = term(op, neg);
+        if (is_sum(op)) t = "(" + t + ")";
+        terms.push_back({t, neg});
+      }
+      // The canonical form starts with a positive term; the sum's sign goes to the caller.
+      negative = !terms.empty() && terms.front().second;
+      std::string s;
+      for (std::size_t i = 0; i < terms.size(); ++i) {
+        const bool neg = terms[i].second != negative;
+        if (i) ++operations;
+        s += i == 0 ? terms[i].first : (neg ? " - " : " + ") + terms[i].first;
       }
       return s;
     }
     if (is_a<GiNaC::mul>(e)) {
       std::vector<std::string> num, den;
-      for (std::size_t i = 0; i < e.nops(); ++i) {
-        const ex& f = e.op(i);
-        if (is_a<GiNaC::numeric>(f)) {
-          GiNaC::numeric n = ex_to<GiNaC::numeric>(f);
-          if (n.is_negative()) {
-            negative = !negative;
-            n = -n;
-          }
-          if (n != 1) num.push_back(number(n));
-          continue;
-        }
+      for (const ex& f : order_.operands(e)) {
+        bool neg = false;
         if (is_a<GiNaC::power>(f) && is_a<GiNaC::numeric>(f.op(1)) &&
             ex_to<GiNaC::numeric>(f.op(1)).is_integer() && ex_to<GiNaC::numeric>(f.op(1)).is_negative()) {
-          den.push_back(factor(GiNaC::pow(f.op(0), -f.op(1))));
-          continue;
+          den.push_back(factor(GiNaC::pow(f.op(0), -f.op(1)), neg));
+        } else if (is_a<GiNaC::numeric>(f)) {
+          std::string n = term(f, neg);
+          if (!f.is_equal(1) && !f.is_equal(-1)) num.push_back(n);
+        } else {
+          num.push_back(factor(f, neg));
         }
-        num.push_back(factor(f));
+        if (neg) negative = !negative;
       }
       std::string s;
       for (std::size_t i = 0; i < num.size(); ++i) {
@@ -129,7 +127,9 @@ class CppPrinter {
         GiNaC::numeric n = ex_to<GiNaC::numeric>(x);
         if (n.is_integer()) {
           long k = n.to_long();
-          std::string base = factor(b);
+          bool neg = false;
+          std::string base = factor(b, neg);
+          negative = neg && (k % 2 != 0);
           std::string s = base;
           for (long i = 1; i < std::labs(k); ++i) {
             ++operations;
@@ -166,6 +166,13 @@ class CppPrinter {
       if (it == known.end())
         throw std::runtime_error("mbsgen: function '" + fname + "' cannot be emitted as C++");
       ++operations;
+      if (e.nops() == 1 && (odd_function(fname) || even_function(fname))) {
+        // f(−x) = ∓f(x): the argument is printed in canonical form, its sign moved outside.
+        bool neg = false;
+        std::string arg = term(e.op(0), neg);
+        negative = neg && odd_function(fname);
+        return it->second + "(" + arg + ")";
+      }
       std::string s = it->second + "(";
       for (std::size_t i = 0; i < e.nops(); ++i) s += (i ? ", " : "") + print(e.op(i));
       return s + ")";
@@ -173,14 +180,17 @@ class CppPrinter {
     throw std::runtime_error("mbsgen: cannot emit expression of this kind");
   }
 
-  // A factor of a product: parenthesised when it is a sum or carries a sign.
-  std::string factor(const ex& e) {
-    bool neg = false;
-    std::string s = term(e, neg);
-    if (neg) {
-      ++operations;
-      return "(-" + (is_sum(e) ? "(" + s + ")" : s) + ")";
-    }
+ private:
+  CanonicalOrder& order_;
+  static bool is_sum(const ex& e) { return is_a<GiNaC::add>(e); }
+  std::string number(const GiNaC::numeric& n) {
+    if (!n.is_real()) throw std::runtime_error("mbsgen: complex number in generated code");
+    return format_double(n.to_double());
+  }
+
+  // A factor of a product without its sign: parenthesised when it is a sum.
+  std::string factor(const ex& e, bool& negative) {
+    std::string s = term(e, negative);
     return is_sum(e) ? "(" + s + ")" : s;
   }
 };
@@ -262,15 +272,22 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
   for (const auto& b : k.outputs)
     for (std::size_t i = 0; i < b.values.size(); ++i)
       statements.push_back({b.name + "[" + std::to_string(i) + "]", b.values[i], false, GiNaC::ex()});
-  if (cse) statements = eliminate_common_subexpressions(statements);
+  if (cse) statements = eliminate_common_subexpressions(statements, prog.order());
 
-  CppPrinter printer;
+  CppPrinter printer(prog.order());
   for (const auto& a : k.inputs)
     for (std::size_t i = 0; i < a.symbols.size(); ++i)
       printer.names[a.symbols[i]] = a.name + "[" + std::to_string(i) + "]";
   std::ostringstream body;
   for (const auto& s : statements) {
-    std::string rhs = printer.print(s.value);
+    bool negative = false;
+    std::string rhs = printer.term(s.value, negative);
+    // A temporary holds its canonical value (the sign its symbol carries); an output its value.
+    if (s.temporary && prog.order().sign(s.symbol) < 0) negative = !negative;
+    if (negative) {
+      ++printer.operations;
+      rhs = is_a<GiNaC::add>(s.value) ? "-(" + rhs + ")" : "-" + rhs;
+    }
     if (s.temporary) {
       body << "  const double " << s.target << " = " << rhs << ";\n";
       printer.names[s.symbol] = s.target;

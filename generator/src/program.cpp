@@ -78,6 +78,9 @@ ex Program::intern_functions(const ex& e) {
     explicit InternChildren(Program* p) : self(p) {}
     ex operator()(const ex& x) override { return self->intern_functions(x); }
   } intern_children(this);
+  // Children first, in canonical order, so that the numbering of new intermediates does not
+  // depend on GiNaC's operand order; the map below then finds them interned.
+  for (const ex& child : order_.operands(e)) intern_functions(child);
   ex mapped = e.nops() > 0 ? e.map(intern_children) : e;
   ex result = mapped;
   if (is_function || is_root) result = define_node(mapped);
@@ -98,6 +101,7 @@ ex Program::define_node(const ex& e) {
   if (auto it = interned_.find(e); it != interned_.end() && is_a<GiNaC::symbol>(it->second))
     return it->second;
   GiNaC::symbol t("t" + std::to_string(defs_.size()));
+  order_.set_sign(t, order_.sign(e));
   deps_.push_back(dependencies(e));
   defs_.push_back({t, e});
   def_index_.emplace(t, defs_.size() - 1);

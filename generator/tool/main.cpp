@@ -5,9 +5,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <sys/personality.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <cstring>
 #include <iostream>
@@ -40,14 +37,6 @@ int print_info(const mbsgen::Model& model, const mbsgen::GeneratedCode& code, do
 }  // namespace
 
 int main(int argc, char** argv) {
-  // GiNaC orders the terms of sums and products by hashes seeded with the addresses of type_info
-  // objects; with address-space randomization that order, and so the emitted text, would change
-  // from run to run. Re-executing once without randomization makes the output byte-identical for
-  // a given mbsgen binary (a canonical order in the emitter itself is still to come).
-  const int persona = personality(0xffffffff);
-  if (persona != -1 && !(persona & ADDR_NO_RANDOMIZE) &&
-      personality(static_cast<unsigned long>(persona) | ADDR_NO_RANDOMIZE) != -1)
-    execv("/proc/self/exe", argv);  // on failure, carry on randomized
 #ifdef MBSGEN_HAVE_LINEAR_CLI
   if (argc >= 2 && std::strcmp(argv[1], "linear") == 0) return mbsgen::cli::linear_main(argc - 1, argv + 1);
 #endif

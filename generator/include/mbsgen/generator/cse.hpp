@@ -1,6 +1,8 @@
 // Common-subexpression elimination on GiNaC expressions (GiNaC has none built in).
 #pragma once
 
+#include "mbsgen/generator/canonical.hpp"
+
 #include <ginac/ginac.h>
 
 #include <string>
@@ -18,7 +20,10 @@ struct Statement {
 
 /// Rewrites the statements so that every non-trivial subexpression (a sum, product, power or
 /// function call, not a lone symbol, number or c·symbol) that occurs more than once is computed
-/// once into a new temporary `c<k>`, placed before its first use. Deterministic.
-std::vector<Statement> eliminate_common_subexpressions(const std::vector<Statement>& in);
+/// once into a new temporary `c<k>`, placed before its first use; e and −e count as the same
+/// subexpression. Deterministic: operands are visited in `order`, which must know the signs of
+/// the statements' intermediates; the new temporaries' signs are added to it.
+std::vector<Statement> eliminate_common_subexpressions(const std::vector<Statement>& in,
+                                                       CanonicalOrder& order);
 
 }  // namespace mbsgen

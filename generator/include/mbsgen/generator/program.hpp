@@ -7,6 +7,8 @@
 // differentiation done symbolically, so their cost is linear in the size of the program.
 #pragma once
 
+#include "mbsgen/generator/canonical.hpp"
+
 #include <ginac/ginac.h>
 
 #include <cstdint>
@@ -55,6 +57,9 @@ class Program {
   GiNaC::ex inline_all(const GiNaC::ex& e);
 
   const std::vector<Definition>& definitions() const { return defs_; }
+  /// The canonical form shared with CSE and emission; each intermediate's symbol carries the
+  /// sign of its definition.
+  CanonicalOrder& order() { return order_; }
   /// Index of an intermediate symbol in definitions(), or -1 for anything else.
   long index_of(const GiNaC::ex& symbol) const;
   std::size_t variable_count() const { return variables_.size(); }
@@ -76,6 +81,7 @@ class Program {
   std::vector<Bits> deps_;
   std::unordered_map<GiNaC::ex, std::size_t, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> def_index_;
   std::unordered_map<GiNaC::ex, GiNaC::ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> interned_;
+  CanonicalOrder order_;  // intermediates are numbered in this order, not in GiNaC's
   std::unordered_map<std::uint64_t, GiNaC::ex> diff_memo_;
   std::unordered_map<std::size_t, GiNaC::ex> inline_memo_;
 };

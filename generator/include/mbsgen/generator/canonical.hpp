@@ -1,0 +1,54 @@
+// A canonical form of GiNaC expressions that does not depend on GiNaC's hash values.
+//
+// GiNaC orders the operands of sums and products by hash, and some of its hashes come from
+// addresses (type-name pointers), so both the stored operand order and the sign a sum carries
+// inside a product ((a − b)·c or −(b − a)·c) can change from one build or run to the next.
+// Everything that names intermediates or prints code goes through this class instead:
+//  - key(e) depends only on the structure of ±e and on symbol names, never on GiNaC's order;
+//  - sign(e) says whether e is +canonical(e) or −canonical(e), where canonical(e) is the form
+//    whose sum terms, in key order, start with a positive coefficient.
+// Symbols standing for intermediates carry the sign of their definition (set_sign): the code
+// stores canonical values, so a temporary t defined as −canonical(v) is printed as −t.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+namespace mbsgen {
+
+class CanonicalOrder {
+ public:
+  struct Signed {
+    std::uint64_t key;
+    int sign;  // +1 or −1
+  };
+  Signed signed_key(const GiNaC::ex& e);
+  std::uint64_t key(const GiNaC::ex& e) { return signed_key(e).key; }
+  int sign(const GiNaC::ex& e) { return signed_key(e).sign; }
+
+  /// e when sign(e) > 0, otherwise −e: the same representative for e and −e.
+  GiNaC::ex representative(const GiNaC::ex& e) { return sign(e) > 0 ? e : GiNaC::ex(-e); }
+
+  /// Declares that symbol s stands for an intermediate of the given sign. Must precede every
+  /// key() of an expression containing s.
+  void set_sign(const GiNaC::ex& s, int sign);
+
+  /// The operands of e in canonical order (sorted by key for sums and products; as stored for
+  /// everything else, whose operand order is meaningful).
+  std::vector<GiNaC::ex> operands(const GiNaC::ex& e);
+
+  /// True when a precedes b (ties, which need a 64-bit collision, fall back to GiNaC's order).
+  bool less(const GiNaC::ex& a, const GiNaC::ex& b);
+
+ private:
+  std::unordered_map<GiNaC::ex, Signed, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> memo_;
+};
+
+/// Odd (f(−x) = −f(x)) and even (f(−x) = f(x)) functions of one argument, by GiNaC name.
+bool odd_function(const std::string& name);
+bool even_function(const std::string& name);
+
+}  // namespace mbsgen

@@ -1,0 +1,148 @@
+#include "mbsgen/generator/canonical.hpp"
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace mbsgen {
+
+using GiNaC::ex;
+using GiNaC::ex_to;
+using GiNaC::is_a;
+
+namespace {
+
+std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
+  // splitmix64 finaliser over the running hash
+  std::uint64_t z = h ^ (v + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2));
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+std::uint64_t text(std::uint64_t tag, const std::string& s) {
+  std::uint64_t h = 1469598103934665603ULL ^ tag;  // FNV-1a
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ULL;
+  return mix(tag, h);
+}
+
+std::string to_text(const ex& e) {
+  std::ostringstream s;
+  s << e;
+  return s.str();
+}
+
+bool commutative(const ex& e) { return is_a<GiNaC::add>(e) || is_a<GiNaC::mul>(e); }
+
+}  // namespace
+
+bool odd_function(const std::string& name) {
+  static const std::set<std::string> odd = {"sin", "tan", "asin", "atan", "sinh", "tanh", "asinh", "atanh"};
+  return odd.count(name) > 0;
+}
+
+bool even_function(const std::string& name) {
+  static const std::set<std::string> even = {"cos", "cosh", "abs"};
+  return even.count(name) > 0;
+}
+
+void CanonicalOrder::set_sign(const ex& s, int sign) {
+  if (!is_a<GiNaC::symbol>(s)) throw std::logic_error("mbsgen::CanonicalOrder::set_sign: not a symbol");
+  auto [it, inserted] = memo_.emplace(s, Signed{text(1, ex_to<GiNaC::symbol>(s).get_name()), sign});
+  if (!inserted && it->second.sign != sign)
+    throw std::logic_error("mbsgen::CanonicalOrder::set_sign: sign of " +
+                           ex_to<GiNaC::symbol>(s).get_name() + " already used");
+}
+
+CanonicalOrder::Signed CanonicalOrder::signed_key(const ex& e) {
+  if (auto it = memo_.find(e); it != memo_.end()) return it->second;
+  Signed r{0, 1};
+  if (is_a<GiNaC::symbol>(e)) {
+    r.key = text(1, ex_to<GiNaC::symbol>(e).get_name());
+  } else if (is_a<GiNaC::numeric>(e)) {
+    GiNaC::numeric n = ex_to<GiNaC::numeric>(e);
+    if (n.is_real() && n.is_negative()) {
+      r.sign = -1;
+      n = -n;
+    }
+    r.key = text(2, to_text(n));
+  } else if (is_a<GiNaC::constant>(e)) {
+    r.key = text(2, to_text(e));
+  } else if (is_a<GiNaC::add>(e)) {
+    std::vector<std::pair<std::uint64_t, int>> terms;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      Signed t = signed_key(e.op(i));
+      terms.push_back({t.key, t.sign});
+    }
+    std::sort(terms.begin(), terms.end());
+    r.sign = terms.empty() ? 1 : terms.front().second;
+    r.key = 3;
+    for (const auto& [k, s] : terms) r.key = mix(mix(r.key, k), static_cast<std::uint64_t>(s * r.sign + 1));
+  } else if (is_a<GiNaC::mul>(e)) {
+    std::vector<std::uint64_t> factors;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      const ex& f = e.op(i);
+      Signed t = signed_key(f);
+      r.sign *= t.sign;
+      if (is_a<GiNaC::numeric>(f) && (f.is_equal(1) || f.is_equal(-1))) continue;
+      factors.push_back(t.key);
+    }
+    std::sort(factors.begin(), factors.end());
+    if (factors.size() == 1) {
+      r.key = factors.front();  // ±x has the key of x
+    } else {
+      r.key = 4;
+      for (std::uint64_t k : factors) r.key = mix(r.key, k);
+    }
+  } else if (is_a<GiNaC::power>(e)) {
+    Signed b = signed_key(e.op(0));
+    Signed x = signed_key(e.op(1));
+    r.key = mix(mix(5, b.key), mix(x.key, static_cast<std::uint64_t>(x.sign + 1)));
+    const ex& n = e.op(1);
+    if (is_a<GiNaC::numeric>(n) && ex_to<GiNaC::numeric>(n).is_integer()) {
+      if (ex_to<GiNaC::numeric>(n).is_odd()) r.sign = b.sign;
+    } else {
+      r.key = mix(r.key, static_cast<std::uint64_t>(b.sign + 1));  // the base's sign matters
+    }
+  } else if (is_a<GiNaC::function>(e)) {
+    const std::string name = ex_to<GiNaC::function>(e).get_name();
+    r.key = text(6, name);
+    if (e.nops() == 1 && (odd_function(name) || even_function(name))) {
+      Signed a = signed_key(e.op(0));
+      r.key = mix(r.key, a.key);
+      if (odd_function(name)) r.sign = a.sign;
+    } else {
+      for (std::size_t i = 0; i < e.nops(); ++i) {
+        Signed a = signed_key(e.op(i));
+        r.key = mix(mix(r.key, a.key), static_cast<std::uint64_t>(a.sign + 1));
+      }
+    }
+  } else {
+    r.key = text(7, ex_to<GiNaC::basic>(e).class_name());
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      Signed a = signed_key(e.op(i));
+      r.key = mix(mix(r.key, a.key), static_cast<std::uint64_t>(a.sign + 1));
+    }
+  }
+  memo_.emplace(e, r);
+  return r;
+}
+
+bool CanonicalOrder::less(const ex& a, const ex& b) {
+  const std::uint64_t ka = key(a), kb = key(b);
+  if (ka != kb) return ka < kb;
+  return a.compare(b) < 0;
+}
+
+std::vector<ex> CanonicalOrder::operands(const ex& e) {
+  std::vector<ex> ops;
+  ops.reserve(e.nops());
+  for (std::size_t i = 0; i < e.nops(); ++i) ops.push_back(e.op(i));
+  if (commutative(e))
+    std::stable_sort(ops.begin(), ops.end(), [this](const ex& a, const ex& b) { return less(a, b); });
+  return ops;
+}
+
+}  // namespace mbsgen
