@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_output.hpp"
 #include "mbsgen/runtime/error.hpp"
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/linear_model.hpp"
@@ -16,32 +17,7 @@
 namespace mbsgen::cli {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kTwoPi = 6.283185307179586476925286766559;
-
-/// Full precision (17 significant digits) or "null" for a non-finite value (JSON has no NaN/Inf).
-std::string num(double v, bool json) {
-  if (!std::isfinite(v)) {
-    if (json) return "null";
-    if (std::isnan(v)) return "nan";
-    return v > 0 ? "inf" : "-inf";
-  }
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
-std::string short_num(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6e", v);
-  return buf;
-}
-
-std::string pad(const std::string& s, std::size_t w) {
-  return s.size() >= w ? s : std::string(w - s.size(), ' ') + s;
-}
 
 struct Common {
   std::string M, K, Q, format = "table";
@@ -66,40 +42,9 @@ int run_modes(const Common& c, bool all, std::ostream& out) {
   opt.one_per_conjugate_pair = !all;
   QuadraticEigenSolver solver(model.size(), opt);
   solver.compute(model);
-  const auto& modes = solver.modes();
-  if (c.format == "json") {
-    out << "{\"modes\":[";
-    for (std::size_t k = 0; k < modes.size(); ++k) {
-      const Mode& m = modes[k];
-      out << (k ? ",\n" : "\n") << "{\"lambda_re\":" << num(m.lambda.real(), true)
-          << ",\"lambda_im\":" << num(m.lambda.imag(), true)
-          << ",\"natural_frequency_hz\":" << num(m.natural_frequency_hz, true)
-          << ",\"damped_frequency_hz\":" << num(m.damped_frequency_hz, true)
-          << ",\"damping_ratio\":" << num(m.damping_ratio, true)
-          << ",\"backward_error\":" << num(m.backward_error, true) << ",\"kind\":\""
-          << to_string(m.kind) << "\"}";
-    }
-    out << "\n]}\n";
-  } else if (c.format == "csv") {
-    out << "lambda_re,lambda_im,natural_frequency_hz,damped_frequency_hz,damping_ratio,"
-           "backward_error,kind\n";
-    for (const Mode& m : modes)
-      out << num(m.lambda.real(), false) << "," << num(m.lambda.imag(), false) << ","
-          << num(m.natural_frequency_hz, false) << "," << num(m.damped_frequency_hz, false)
-          << "," << num(m.damping_ratio, false) << "," << num(m.backward_error, false) << ","
-          << to_string(m.kind) << "\n";
-  } else {
-    out << pad("#", 4) << pad("lambda_re", 15) << pad("lambda_im", 15) << pad("f_n [Hz]", 15)
-        << pad("f_d [Hz]", 15) << pad("zeta", 15) << pad("backward_err", 15) << "  kind\n";
-    int k = 1;
-    for (const Mode& m : modes)
-      out << pad(std::to_string(k++), 4) << pad(short_num(m.lambda.real()), 15)
-          << pad(short_num(m.lambda.imag()), 15) << pad(short_num(m.natural_frequency_hz), 15)
-          << pad(short_num(m.damped_frequency_hz), 15) << pad(short_num(m.damping_ratio), 15)
-          << pad(short_num(m.backward_error), 15) << "  " << to_string(m.kind) << "\n";
-    out << "# method " << solver.method() << ", rank M " << solver.rank_M() << "/"
-        << model.size() << ", rank K " << solver.rank_K() << "/" << model.size() << "\n";
-  }
+  ModesFormat f;
+  f.format = c.format;
+  write_modes(out, solver, model.size(), f);
   return 0;
 }
 
@@ -129,41 +74,11 @@ int run_frf(const Common& c, const FrfArgs& a, std::ostream& out, std::ostream& 
   FrequencyResponse frf(model, opt);
   frf.compute(hz * kTwoPi, a.input - 1, {a.output - 1});
   for (const auto& w : frf.warnings()) err << "mbsgen linear frf: warning: " << w << "\n";
-  const auto& g = frf.response();
-  if (c.format == "json") {
-    out << "{\"input\":" << a.input << ",\"output\":" << a.output << ",\"points\":[";
-    for (long k = 0; k < a.points; ++k) {
-      const std::complex<double> v = g(0, k);
-      out << (k ? ",\n" : "\n") << "{\"frequency_hz\":" << num(hz[k], true)
-          << ",\"re\":" << num(v.real(), true) << ",\"im\":" << num(v.imag(), true)
-          << ",\"amplitude\":" << num(amplitude(v), true)
-          << ",\"phase_lag_deg\":" << num(phase_lag(v) * 180.0 / kPi, true)
-          << ",\"rcond\":" << num(frf.rcond()[k], true) << ",\"flag\":\""
-          << to_string(frf.flags()[static_cast<std::size_t>(k)]) << "\"}";
-    }
-    out << "\n]}\n";
-  } else if (c.format == "csv") {
-    out << "frequency_hz,re,im,amplitude,phase_lag_deg,rcond,flag\n";
-    for (long k = 0; k < a.points; ++k) {
-      const std::complex<double> v = g(0, k);
-      out << num(hz[k], false) << "," << num(v.real(), false) << "," << num(v.imag(), false)
-          << "," << num(amplitude(v), false) << "," << num(phase_lag(v) * 180.0 / kPi, false)
-          << "," << num(frf.rcond()[k], false) << ","
-          << to_string(frf.flags()[static_cast<std::size_t>(k)]) << "\n";
-    }
-  } else {
-    out << pad("f [Hz]", 15) << pad("re", 15) << pad("im", 15) << pad("amplitude", 15)
-        << pad("phase_lag[deg]", 15) << pad("rcond", 15) << "  flag\n";
-    for (long k = 0; k < a.points; ++k) {
-      const std::complex<double> v = g(0, k);
-      out << pad(short_num(hz[k]), 15) << pad(short_num(v.real()), 15)
-          << pad(short_num(v.imag()), 15) << pad(short_num(amplitude(v)), 15)
-          << pad(short_num(phase_lag(v) * 180.0 / kPi), 15) << pad(short_num(frf.rcond()[k]), 15)
-          << "  " << to_string(frf.flags()[static_cast<std::size_t>(k)]) << "\n";
-    }
-    out << "# input " << a.input << ", output " << a.output << ", method "
-        << to_string(frf.method()) << "\n";
-  }
+  FrfTable t;
+  t.format = c.format;
+  t.input_json = t.input_label = std::to_string(a.input);
+  t.output_json = t.output_label = std::to_string(a.output);
+  write_frf(out, {hz, frf.response().row(0).transpose(), frf.rcond(), frf.flags(), frf.method()}, t);
   return 0;
 }
 

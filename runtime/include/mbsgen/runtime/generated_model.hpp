@@ -1,0 +1,102 @@
+// A model compiled from generated kernels (issue 4): parameters by name, the operating point
+// (given, or a static equilibrium found by Newton's method) and the LinearModel there.
+//
+// The generator writes, beside the C kernels <id>.cpp, a typed API <id>_model.hpp whose
+// `kernels()` returns the ModelKernels below; GeneratedModel works on any of them, so the solver
+// command line (solver_cli.hpp) is one program for every model.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+#include "mbsgen/runtime/error.hpp"
+#include "mbsgen/runtime/linear_model.hpp"
+
+namespace mbsgen {
+
+/// ABI version of the generated kernels this runtime understands (the generator's kAbiVersion).
+constexpr int kKernelAbiVersion = 1;
+
+/// Description of one generated model (one scene): sizes, names, defaults and the C kernels.
+/// Kernels a scene does not need are null. Matrices are column-major.
+struct ModelKernels {
+  const char* id;
+  const char* model;
+  const char* scene;
+  int abi_version;
+  int n_coordinates, n_inputs, n_outputs, n_parameters;
+  bool at_rest;      ///< the operating point has ẏ0 = 0 (yd0 is not an argument of `linear`)
+  bool equilibrium;  ///< the operating point is a static equilibrium (operating_point = guess)
+  double default_from_hz, default_to_hz;  ///< the scene's frequency range (0, 0: none given)
+  const char* const* coordinate_names;
+  const char* const* coordinate_units;
+  const char* const* parameter_names;
+  const char* const* parameter_units;
+  const double* parameter_defaults;
+  const char* const* input_names;
+  const char* const* input_units;
+  const char* const* output_names;
+  const char* const* output_units;
+  int (*operating_point)(const double* p, double* y0, double* yd0);
+  int (*linear)(const double* y0, const double* yd0, const double* p, double* M, double* Q,
+                double* K, double* B, double* Cy, double* Cv);
+  int (*residual)(const double* y, const double* yd, const double* u, const double* p, double* r);
+  int (*mass_matrix)(const double* y, const double* p, double* M);
+};
+
+/// A bad name or value from the user (unknown parameter, input or output; malformed value).
+/// The message names what is wrong and lists what exists.
+class NameError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// The operating point of a GeneratedModel.
+struct OperatingPoint {
+  Eigen::VectorXd y0, yd0;
+  bool equilibrium = false;  ///< found by Newton's method (otherwise given by the model)
+  int iterations = 0;        ///< Newton steps
+  double residual_norm = 0;  ///< ‖k − q‖₂ at (y0, yd0, u = 0), N or N·m
+  std::string report;        ///< one line: how the point was obtained
+};
+
+class GeneratedModel {
+ public:
+  /// Throws mbsgen::Error when the kernels' ABI version differs from kKernelAbiVersion.
+  explicit GeneratedModel(const ModelKernels& kernels);
+
+  const ModelKernels& kernels() const { return k_; }
+  Eigen::Index size() const { return k_.n_coordinates; }
+
+  const std::vector<std::string>& parameter_names() const { return parameter_names_; }
+  const std::vector<double>& parameters() const { return p_; }
+  /// Sets a parameter by name; NameError for an unknown name (listing the known ones),
+  /// NonFiniteError for a NaN or infinite value.
+  void set(const std::string& name, double value);
+  /// Parses "NAME=VALUE" (as `--set` gives it) and calls set(); NameError when malformed.
+  void set(const std::string& assignment);
+
+  /// Index of a coordinate, input or output by name; NameError listing the known ones.
+  Eigen::Index input_index(const std::string& name) const;
+  Eigen::Index output_index(const std::string& name) const;
+
+  /// The operating point: given by the model, or a static equilibrium from the model's initial
+  /// guess (Newton with line search on the residual kernel, Jacobian K from the linear kernel).
+  /// Throws ConvergenceError or SingularSystemError when no equilibrium is found, NonFiniteError
+  /// when a kernel returns a non-finite value.
+  OperatingPoint operating_point() const;
+
+  /// M, Q, K, B, C_y, C_v at the operating point, with names and units.
+  LinearModel linear_model(const OperatingPoint& op) const;
+  LinearModel linear_model() const { return linear_model(operating_point()); }
+
+ private:
+  Eigen::VectorXd residual(const Eigen::VectorXd& y, const Eigen::VectorXd& yd) const;
+  const ModelKernels& k_;
+  std::vector<std::string> parameter_names_;
+  std::vector<double> p_;
+};
+
+}  // namespace mbsgen

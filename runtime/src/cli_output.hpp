@@ -1,0 +1,54 @@
+// Result formatting shared by `mbsgen linear` and the model solvers (docs/cli.md): tables for
+// people, JSON and CSV for programs, full precision in the machine formats.
+#pragma once
+
+#include <complex>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mbsgen/runtime/frequency_response.hpp"
+#include "mbsgen/runtime/quadratic_eigen.hpp"
+
+namespace mbsgen::cli {
+
+/// 17 significant digits, or "null" (JSON) / "nan", "inf" for a non-finite value.
+std::string num(double v, bool json);
+/// %.6e, for tables.
+std::string short_num(double v);
+/// Right-aligned in a field of width w.
+std::string pad(const std::string& s, std::size_t w);
+/// A JSON string literal.
+std::string json_string(const std::string& s);
+
+struct ModesFormat {
+  std::string format = "table";                  // table | json | csv
+  bool shapes = false;                           // print mode shapes
+  std::vector<std::string> coordinate_names;     // for shapes
+};
+
+/// Writes the modes; the table ends with a line "# method …, rank M …, rank K …".
+void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::Index size,
+                 const ModesFormat& f);
+
+struct FrfTable {
+  std::string format = "table";
+  std::string input_json, output_json;    // JSON values of "input" and "output"
+  std::string input_label, output_label;  // for the table's last line
+};
+
+/// One output's response to one input at the frequencies hz, as computed.
+struct FrfResult {
+  Eigen::VectorXd hz;
+  Eigen::VectorXcd g;
+  Eigen::VectorXd rcond;
+  std::vector<FrfFlag> flags;
+  FrfMethod method = FrfMethod::automatic;
+};
+
+/// Writes the response of one output to one input at the frequencies hz.
+void write_frf(std::ostream& out, const FrfResult& r, const FrfTable& t);
+
+}  // namespace mbsgen::cli

@@ -1,0 +1,146 @@
+#include "mbsgen/runtime/generated_model.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+#include "mbsgen/runtime/static_equilibrium.hpp"
+
+namespace mbsgen {
+
+namespace {
+
+std::vector<std::string> names(const char* const* list, int n) {
+  std::vector<std::string> v;
+  for (int i = 0; i < n; ++i) v.emplace_back(list && list[i] ? list[i] : "");
+  return v;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
+  return s.empty() ? "(none)" : s;
+}
+
+Eigen::Index find(const std::vector<std::string>& list, const std::string& name,
+                  const std::string& what, const std::string& model) {
+  for (std::size_t i = 0; i < list.size(); ++i)
+    if (list[i] == name) return static_cast<Eigen::Index>(i);
+  throw NameError("unknown " + what + " '" + name + "' of model '" + model + "'; known: " + join(list));
+}
+
+void check_status(int status, const char* kernel, const std::string& model) {
+  if (status != 0)
+    throw NonFiniteError(std::string("kernel ") + kernel + " of model '" + model +
+                         "' returned a non-finite value (check the parameters)");
+}
+
+}  // namespace
+
+GeneratedModel::GeneratedModel(const ModelKernels& kernels) : k_(kernels) {
+  if (k_.abi_version != kKernelAbiVersion)
+    throw Error("GeneratedModel: model '" + std::string(k_.id) + "' has kernel ABI version " +
+                std::to_string(k_.abi_version) + ", this runtime expects " +
+                std::to_string(kKernelAbiVersion) + "; regenerate it");
+  if (!k_.operating_point || !k_.linear)
+    throw Error("GeneratedModel: model '" + std::string(k_.id) +
+                "' lacks the operating_point or linear kernel (its scene asks for no linear analysis)");
+  parameter_names_ = names(k_.parameter_names, k_.n_parameters);
+  p_.assign(k_.parameter_defaults, k_.parameter_defaults + k_.n_parameters);
+}
+
+void GeneratedModel::set(const std::string& name, double value) {
+  const Eigen::Index i = find(parameter_names_, name, "parameter", k_.model);
+  if (!std::isfinite(value))
+    throw NonFiniteError("parameter '" + name + "' set to a non-finite value");
+  p_[static_cast<std::size_t>(i)] = value;
+}
+
+void GeneratedModel::set(const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == assignment.size())
+    throw NameError("malformed assignment '" + assignment + "': expected NAME=VALUE");
+  const std::string name = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || errno == ERANGE)
+    throw NameError("malformed value '" + text + "' for parameter '" + name + "': expected a number");
+  set(name, value);
+}
+
+Eigen::Index GeneratedModel::input_index(const std::string& name) const {
+  return find(names(k_.input_names, k_.n_inputs), name, "input", k_.model);
+}
+
+Eigen::Index GeneratedModel::output_index(const std::string& name) const {
+  return find(names(k_.output_names, k_.n_outputs), name, "output", k_.model);
+}
+
+Eigen::VectorXd GeneratedModel::residual(const Eigen::VectorXd& y, const Eigen::VectorXd& yd) const {
+  Eigen::VectorXd r(size());
+  std::vector<double> u(static_cast<std::size_t>(std::max(k_.n_inputs, 1)), 0.0);
+  check_status(k_.residual(y.data(), yd.data(), u.data(), p_.data(), r.data()), "residual", k_.model);
+  return r;
+}
+
+OperatingPoint GeneratedModel::operating_point() const {
+  const Eigen::Index f = size();
+  OperatingPoint op;
+  op.y0.setZero(f);
+  op.yd0.setZero(f);
+  check_status(k_.operating_point(p_.data(), op.y0.data(), op.yd0.data()), "operating_point", k_.model);
+  if (!k_.residual) {
+    op.report = "given by the model";
+    op.residual_norm = std::nan("");
+    return op;
+  }
+  const Eigen::VectorXd yd0 = op.yd0;
+  if (!k_.equilibrium) {
+    op.residual_norm = residual(op.y0, yd0).norm();
+    op.report = "given by the model";
+    return op;
+  }
+  const Eigen::Index m = k_.n_inputs, r = k_.n_outputs;
+  Eigen::MatrixXd M(f, f), Q(f, f), B(f, std::max<Eigen::Index>(m, 1)), Cy(std::max<Eigen::Index>(r, 1), f),
+      Cv(std::max<Eigen::Index>(r, 1), f);
+  StaticEquilibrium newton(f);
+  newton.compute(
+      [&](const Eigen::VectorXd& y, Eigen::VectorXd& res) { res = residual(y, yd0); },
+      [&](const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
+        J.resize(f, f);
+        check_status(k_.linear(y.data(), yd0.data(), p_.data(), M.data(), Q.data(), J.data(),
+                               B.data(), Cy.data(), Cv.data()),
+                     "linear", k_.model);
+      },
+      op.y0);
+  newton.throw_if_failed();
+  op.y0 = newton.solution();
+  op.equilibrium = true;
+  op.iterations = newton.iterations();
+  op.residual_norm = newton.residual_norm();
+  op.report = newton.report();
+  return op;
+}
+
+LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
+  const Eigen::Index f = size(), m = k_.n_inputs, r = k_.n_outputs;
+  if (op.y0.size() != f || op.yd0.size() != f)
+    throw DimensionError("GeneratedModel::linear_model: operating point of size " +
+                         std::to_string(op.y0.size()) + "/" + std::to_string(op.yd0.size()) +
+                         " for a model with " + std::to_string(f) + " coordinates");
+  Eigen::MatrixXd M(f, f), Q(f, f), K(f, f), B(f, m), Cy(r, f), Cv(r, f);
+  // Kernels write nothing into zero-sized buffers; give them valid pointers anyway.
+  double dummy[1];
+  auto ptr = [&dummy](Eigen::MatrixXd& A) { return A.size() ? A.data() : dummy; };
+  check_status(k_.linear(op.y0.data(), op.yd0.data(), p_.data(), ptr(M), ptr(Q), ptr(K), ptr(B),
+                         ptr(Cy), ptr(Cv)),
+               "linear", k_.model);
+  return LinearModel(std::move(M), std::move(Q), std::move(K), std::move(B), std::move(Cy),
+                     std::move(Cv), names(k_.coordinate_names, k_.n_coordinates),
+                     names(k_.input_names, k_.n_inputs), names(k_.output_names, k_.n_outputs),
+                     names(k_.coordinate_units, k_.n_coordinates),
+                     names(k_.input_units, k_.n_inputs), names(k_.output_units, k_.n_outputs));
+}
+
+}  // namespace mbsgen
