@@ -4,6 +4,25 @@
 
 namespace mbsgen {
 
+namespace {
+
+void add_chain_scenes(Model& model) {
+  Scene undamped;
+  undamped.name = "no_damping";
+  undamped.description = "modes without the joint dampers";
+  undamped.analyses = {Analysis::modes};
+  undamped.without = {{"dampers", {}}};
+  model.add_scene(undamped);
+  Scene weightless;
+  weightless.name = "no_gravity";
+  weightless.description = "modes and statics without gravity";
+  weightless.analyses = {Analysis::modes, Analysis::statics};
+  weightless.without = {{"gravity", {}}};
+  model.add_scene(weightless);
+}
+
+}  // namespace
+
 Model planar_chain(int n) {
   Model model("planar_chain_" + std::to_string(n));
   GiNaC::ex g = model.add_parameter("g", 9.81, "m/s^2");
@@ -29,11 +48,13 @@ Model planar_chain(int n) {
   model.add_gravity({"gravity", {GiNaC::ex(0), -g, GiNaC::ex(0)}, {}});
   for (int i = 0; i < n; ++i) {
     const Coordinate& q = model.coordinates()[static_cast<std::size_t>(i)];
-    model.add_generalized_force({"joint" + std::to_string(i + 1), q.name,
-                                 -k[static_cast<std::size_t>(i)] * q.position -
-                                     c[static_cast<std::size_t>(i)] * q.velocity,
-                                 {}});
+    const std::string s = std::to_string(i + 1);
+    model.add_generalized_force({"joint_spring" + s, q.name, -k[static_cast<std::size_t>(i)] * q.position,
+                                 {}, Category::springs});
+    model.add_generalized_force({"joint_damper" + s, q.name, -c[static_cast<std::size_t>(i)] * q.velocity,
+                                 {}, Category::dampers});
   }
+  add_chain_scenes(model);
   return model;
 }
 
@@ -68,8 +89,11 @@ Model spatial_chain(int n) {
     model.add_body(b);
   }
   model.add_gravity({"gravity", {GiNaC::ex(0), GiNaC::ex(0), -g}, {}});
-  for (const auto& q : std::vector<Coordinate>(model.coordinates()))
-    model.add_generalized_force({"joint_" + q.name, q.name, -k * q.position - c * q.velocity, {}});
+  for (const auto& q : std::vector<Coordinate>(model.coordinates())) {
+    model.add_generalized_force({"spring_" + q.name, q.name, -k * q.position, {}, Category::springs});
+    model.add_generalized_force({"damper_" + q.name, q.name, -c * q.velocity, {}, Category::dampers});
+  }
+  add_chain_scenes(model);
   return model;
 }
 

@@ -33,8 +33,10 @@ Equations derive(const Model& model) {
   std::vector<Spatial> wrench(nb);
   for (std::size_t i = 0; i < nb; ++i) {
     const BodyKinematics& b = kin.bodies[i];
-    Spatial IV = define(prog, apply(b.inertia, b.V));
-    wrench[i] = add(apply(b.inertia, b.bias), cross_force(b.V, IV));
+    if (model.inertial_velocity_terms()) {  // I ā + V ×* I V: quadratic in ẏ
+      Spatial IV = define(prog, apply(b.inertia, b.V));
+      wrench[i] = add(apply(b.inertia, b.bias), cross_force(b.V, IV));
+    }
     for (const auto& g : model.gravity()) {
       Vec3 force = scale(b.inertia.m, g.g);
       wrench[i] = add(wrench[i], scale(-1, Spatial{cross(b.inertia.h, g.g), force}));

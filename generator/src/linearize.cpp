@@ -1,8 +1,123 @@
 #include "mbsgen/generator/linearize.hpp"
 
+#include <algorithm>
+#include <cstdint>
+
 namespace mbsgen {
 
 using GiNaC::ex;
+
+namespace {
+
+// Values of program expressions at one point of the variables, in floating point of kDigits
+// decimal digits. Reads the program's definitions only (defines nothing).
+class PointEvaluator {
+ public:
+  static constexpr long kDigits = 50;
+
+  PointEvaluator(const Program& program, GiNaC::exmap point) : prog_(program), values_(std::move(point)) {}
+
+  std::vector<GiNaC::numeric> evaluate(const std::vector<ex>& entries) {
+    const auto& defs = prog_.definitions();
+    std::vector<char> needed(defs.size(), 0);
+    std::vector<ex> stack(entries);
+    while (!stack.empty()) {
+      ex e = stack.back();
+      stack.pop_back();
+      if (GiNaC::is_a<GiNaC::symbol>(e)) {
+        const long i = prog_.index_of(e);
+        if (i >= 0 && !needed[static_cast<std::size_t>(i)] && !values_.count(e)) {
+          needed[static_cast<std::size_t>(i)] = 1;
+          stack.push_back(defs[static_cast<std::size_t>(i)].value);
+        }
+        continue;
+      }
+      for (std::size_t i = 0; i < e.nops(); ++i) stack.push_back(e.op(i));
+    }
+    // A definition refers to earlier ones only.
+    for (std::size_t i = 0; i < defs.size(); ++i)
+      if (needed[i]) values_[defs[i].symbol] = number(defs[i].value);
+    std::vector<GiNaC::numeric> out;
+    out.reserve(entries.size());
+    for (const ex& e : entries) out.push_back(number(e));
+    return out;
+  }
+
+ private:
+  GiNaC::numeric number(const ex& e) const {
+    const ex v = GiNaC::evalf(e.subs(values_, GiNaC::subs_options::no_pattern));
+    if (!GiNaC::is_a<GiNaC::numeric>(v)) throw std::runtime_error("not a number");
+    return GiNaC::ex_to<GiNaC::numeric>(v);
+  }
+  const Program& prog_;
+  GiNaC::exmap values_;
+};
+
+struct Structure {
+  bool D_zero = false, G_zero = false, N_zero = false;
+};
+
+// Whether sym Q, skew Q and skew K vanish identically: as functions of all the kernels'
+// arguments (y0, ẏ0, p), or, with at_operating_point, of the parameters p with (y0, ẏ0) the
+// operating point (y0 free for an equilibrium, which Newton's method finds). They are evaluated
+// at two pseudo-random points with 50 digits and called zero when every entry is below 1e-35 of
+// the matrix's largest entry at both points. A nonzero analytic function vanishes only on a set
+// of measure zero, and 15 digits of margin cover the cancellation in the sums, so the test errs
+// in neither direction in practice; a point where the evaluation fails (a pole) gives
+// "nonzero", the safe answer.
+Structure structure_of(const Equations& eq, const LinearEquations& lin, bool at_operating_point) {
+  const std::size_t f = lin.Q.size();
+  std::vector<ex> entries;
+  for (const ExMatrix* A : {&lin.Q, &lin.K})
+    for (std::size_t i = 0; i < f; ++i)
+      for (std::size_t j = 0; j < f; ++j) entries.push_back((*A)[i][j]);
+  Structure s{true, true, true};
+  const long digits = GiNaC::Digits;
+  GiNaC::Digits = PointEvaluator::kDigits;
+  std::uint64_t state = 0x2545f4914f6cdd1dULL;
+  try {
+    for (int point = 0; point < 2; ++point) {
+      GiNaC::exmap values;
+      for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p})
+        for (const auto& x : *group) {
+          state ^= state << 13, state ^= state >> 7, state ^= state << 17;  // xorshift64
+          values[x] = GiNaC::numeric(static_cast<long>(state % 2000000) + 500000, 1000000);
+        }
+      if (at_operating_point) {
+        GiNaC::exmap p;
+        for (const auto& x : eq.p) p[x] = values[x];
+        for (std::size_t k = 0; k < f; ++k) {
+          if (!lin.equilibrium) values[eq.y[k]] = GiNaC::evalf(lin.y0[k].subs(p, GiNaC::subs_options::no_pattern));
+          values[eq.yd[k]] = GiNaC::evalf(lin.yd0[k].subs(p, GiNaC::subs_options::no_pattern));
+        }
+      }
+      const std::vector<GiNaC::numeric> v = PointEvaluator(eq.program, values).evaluate(entries);
+      auto at = [&](std::size_t matrix, std::size_t i, std::size_t j) { return v[matrix * f * f + i * f + j]; };
+      for (std::size_t matrix = 0; matrix < 2; ++matrix) {
+        GiNaC::numeric scale = 0, sym = 0, skew = 0;
+        for (std::size_t i = 0; i < f; ++i)
+          for (std::size_t j = 0; j < f; ++j) {
+            scale = std::max(scale, GiNaC::abs(at(matrix, i, j)));
+            sym = std::max(sym, GiNaC::abs(at(matrix, i, j) + at(matrix, j, i)));
+            skew = std::max(skew, GiNaC::abs(at(matrix, i, j) - at(matrix, j, i)));
+          }
+        const GiNaC::numeric tol = scale * GiNaC::numeric(1, 100000) * GiNaC::numeric(10).power(-30);
+        if (matrix == 0) {
+          s.D_zero = s.D_zero && sym <= tol;
+          s.G_zero = s.G_zero && skew <= tol;
+        } else {
+          s.N_zero = s.N_zero && skew <= tol;
+        }
+      }
+    }
+  } catch (const std::exception&) {
+    s = Structure{};
+  }
+  GiNaC::Digits = digits;
+  return s;
+}
+
+}  // namespace
 
 LinearEquations linearize(Equations& eq) {
   const Model& model = *eq.model;
@@ -63,6 +178,29 @@ LinearEquations linearize(Equations& eq) {
         W[i][j] = (A[i][j] - A[j][i]) / 2;
       }
   };
+  // Identically vanishing parts are written as exact zeros, and the matching symmetry of Q and
+  // K is made exact: each pair of entries is then computed once, and the kernels return exactly
+  // symmetric (or skew) matrices.
+  const Structure st = structure_of(eq, lin, false);
+  Structure op_structure = st;
+  if (!(st.D_zero && st.G_zero && st.N_zero)) {
+    const Structure s = structure_of(eq, lin, true);
+    op_structure = {st.D_zero || s.D_zero, st.G_zero || s.G_zero, st.N_zero || s.N_zero};
+  }
+  lin.D_zero = op_structure.D_zero;
+  lin.G_zero = op_structure.G_zero;
+  lin.N_zero = op_structure.N_zero;
+  for (std::size_t i = 0; i < f; ++i)
+    for (std::size_t j = 0; j <= i; ++j) {
+      if (st.D_zero && st.G_zero) {
+        lin.Q[i][j] = lin.Q[j][i] = 0;
+      } else if (st.G_zero) {
+        lin.Q[i][j] = lin.Q[j][i];
+      } else if (st.D_zero) {
+        lin.Q[i][j] = i == j ? ex(0) : ex(-lin.Q[j][i]);
+      }
+      if (st.N_zero) lin.K[i][j] = lin.K[j][i];
+    }
   split(lin.Q, lin.D, lin.G);
   split(lin.K, lin.Ks, lin.N);
   return lin;

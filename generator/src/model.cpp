@@ -1,5 +1,7 @@
 #include "mbsgen/generator/model.hpp"
 
+#include "mbsgen/generator/scene.hpp"
+
 #include <cctype>
 #include <cmath>
 #include <functional>
@@ -33,6 +35,27 @@ Mat3 identity_mat3() {
   Mat3 m = zero_mat3();
   for (int i = 0; i < 3; ++i) m[i][i] = 1;
   return m;
+}
+
+const char* to_string(Category category) {
+  switch (category) {
+    case Category::gravity: return "gravity";
+    case Category::springs: return "springs";
+    case Category::dampers: return "dampers";
+    case Category::gyroscopic: return "gyroscopic";
+    case Category::generalized: return "generalized";
+    case Category::applied: return "applied";
+  }
+  return "";
+}
+
+const char* to_string(Analysis analysis) {
+  switch (analysis) {
+    case Analysis::modes: return "modes";
+    case Analysis::frf: return "frf";
+    case Analysis::statics: return "static";
+  }
+  return "";
 }
 
 Model::Model(std::string name) : name_(std::move(name)) {}
@@ -148,6 +171,26 @@ void Model::add_applied_force(AppliedForce force) {
 void Model::add_output(Output output) {
   check_new_element(output.name, "output", output.where);
   outputs_.push_back(std::move(output));
+}
+
+void Model::add_scene(Scene scene) {
+  const std::string& name = scene.name;
+  bool valid = !name.empty() && std::isalpha(static_cast<unsigned char>(name[0]));
+  for (char c : name) valid = valid && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
+  if (!valid)
+    throw ModelError(scene.where, "'" + name + "' is not a valid scene name (a letter, then letters, digits and _)");
+  if (name == kFullScene)
+    throw ModelError(scene.where, "'full' is the implicit scene of the whole model; choose another name");
+  for (const auto& s : scenes_)
+    if (s.name == name)
+      throw ModelError(scene.where, "duplicate scene '" + name + "' (first at " + s.where.str() + ")");
+  scenes_.push_back(std::move(scene));
+}
+
+const Scene* Model::scene(const std::string& name) const {
+  for (const auto& s : scenes_)
+    if (s.name == name) return &s;
+  return nullptr;
 }
 
 GiNaC::ex Model::symbol(const std::string& name) const {
@@ -319,6 +362,7 @@ void Model::validate() const {
     check_expr(value, operating_point_.where, "an operating point", parameters_only);
   }
   if (coordinates_.empty()) throw ModelError({}, "model '" + name_ + "' has no coordinates");
+  for (const auto& s : scenes_) check_scene(*this, s);
 }
 
 }  // namespace mbsgen

@@ -33,11 +33,6 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return d[n][m];
 }
 
-}  // namespace detail
-
-namespace {
-
-// " (did you mean 'x'?)" for the closest candidate within a small edit distance, else "".
 std::string suggestion(const std::string& word, const std::vector<std::string>& candidates) {
   const std::size_t limit = word.size() <= 3 ? 1 : word.size() <= 6 ? 2 : 3;
   std::size_t best = limit + 1;
@@ -51,6 +46,12 @@ std::string suggestion(const std::string& word, const std::vector<std::string>& 
   }
   return best_name.empty() ? std::string() : " (did you mean '" + best_name + "'?)";
 }
+
+}  // namespace detail
+
+namespace {
+
+using detail::suggestion;
 
 std::string join(const std::vector<std::string>& words) {
   std::string out;
@@ -587,6 +588,9 @@ class Reader {
   void read_force(const YAML::Node& n, std::map<std::string, int>& counters);
   void read_output(const YAML::Node& n);
   void read_operating_point(const Entry& e);
+  OperatingPointOverride read_operating_point_values(const YAML::Node& n, const std::string& what);
+  void read_scene(const YAML::Node& n);
+  std::vector<SceneItem> items(const Entry& e, const std::string& what) const;
   void define(SymbolKind kind, const std::string& name) { kinds_[name] = kind; }
 
   const std::string& text_;
@@ -612,7 +616,7 @@ Model Reader::read() {
   const YAML::Node root = docs[0];
   const Fields top = fields(root, "the model file",
                             {"model", "parameters", "coordinates", "inputs", "bodies", "markers",
-                             "forces", "outputs", "operating_point"});
+                             "forces", "outputs", "operating_point", "scenes"});
 
   const Entry& name_entry = require(top, "model", root, "the model file");
   const std::string model_name = name(name_entry, "the model name");
@@ -647,6 +651,7 @@ Model Reader::read() {
   for (const auto& o : outputs) read_output(o);
 
   if (const Entry* op = find(top, "operating_point")) read_operating_point(*op);
+  for (const auto& sc : list(find(top, "scenes"), "scenes")) read_scene(sc);
 
   try {
     model.validate();
@@ -823,7 +828,7 @@ void Reader::read_force(const YAML::Node& n, std::map<std::string, int>& counter
   if (type == "spring") keys.insert(keys.end(), {"between", "stiffness", "rest_length"});
   if (type == "damper") keys.insert(keys.end(), {"between", "damping"});
   if (type == "bushing") keys.insert(keys.end(), {"between", "stiffness", "damping"});
-  if (type == "generalized") keys.insert(keys.end(), {"coordinate", "value"});
+  if (type == "generalized") keys.insert(keys.end(), {"coordinate", "value", "category"});
   if (type == "applied") keys.insert(keys.end(), {"marker", "frame", "force", "torque"});
   const std::string what = "a " + type + " force";
   const Fields f = fields(n, what, keys);
@@ -900,6 +905,19 @@ void Reader::read_force(const YAML::Node& n, std::map<std::string, int>& counter
     g.name = force_name;
     g.coordinate = check_coordinate(value(require(f, "coordinate", n, what)));
     g.value = expr(require(f, "value", n, what), "a generalized force", Scope::any);
+    if (const Entry* c = find(f, "category")) {
+      const YAML::Node& cn = value(*c);
+      const std::string category = scalar(cn, "a category");
+      static const std::vector<std::string> allowed = {"generalized", "springs", "dampers"};
+      if (category == "springs") g.category = Category::springs;
+      else if (category == "dampers") g.category = Category::dampers;
+      else if (category != "generalized")
+        fail(cn, "unknown category '" + category + "' of a generalized force" +
+                     [&] {
+                       std::string h = suggestion(category, allowed);
+                       return h.empty() ? " (one of: " + join(allowed) + ")" : h;
+                     }());
+    }
     g.where = where;
     model_->add_generalized_force(g);
   } else {  // applied
@@ -960,8 +978,18 @@ void Reader::read_output(const YAML::Node& n) {
 
 void Reader::read_operating_point(const Entry& e) {
   const YAML::Node& n = value(e);
-  const Fields f = fields(n, "the operating point", {"type", "position", "velocity"});
+  const OperatingPointOverride values = read_operating_point_values(n, "the operating point");
   OperatingPoint op;
+  op.where = values.where;
+  op.kind = values.kind.value_or(OperatingPoint::Kind::given);
+  op.position = values.position;
+  op.velocity = values.velocity;
+  model_->set_operating_point(op);
+}
+
+OperatingPointOverride Reader::read_operating_point_values(const YAML::Node& n, const std::string& what) {
+  const Fields f = fields(n, what, {"type", "position", "velocity"});
+  OperatingPointOverride op;
   op.where = loc(n);
   if (const Entry* t = find(f, "type")) {
     const YAML::Node& tn = value(*t);
@@ -987,7 +1015,89 @@ void Reader::read_operating_point(const Entry& e) {
   };
   values("position", op.position);
   values("velocity", op.velocity);
-  model_->set_operating_point(op);
+  return op;
+}
+
+std::vector<SceneItem> Reader::items(const Entry& e, const std::string& what) const {
+  std::vector<SceneItem> out;
+  for (const auto& n : list(&e, what)) out.push_back({scalar(n, "a name in " + what), loc(n)});
+  return out;
+}
+
+void Reader::read_scene(const YAML::Node& n) {
+  const Fields f = fields(n, "a scene",
+                          {"name", "description", "analyses", "effects", "without", "inputs",
+                           "outputs", "operating_point", "frequency_range"});
+  Scene s;
+  s.name = name(require(f, "name", n, "a scene"), "a scene name");
+  s.where = loc(n);
+  const std::string what = "scene '" + s.name + "'";
+  if (const Entry* d = find(f, "description")) s.description = scalar(value(*d), "a description");
+  if (const Entry* a = find(f, "analyses")) {
+    static const std::vector<std::string> known = {"modes", "frf", "static"};
+    s.analyses.clear();
+    std::map<std::string, SourceLocation> seen;
+    for (const auto& an : list(a, "the analyses of " + what)) {
+      const std::string k = scalar(an, "an analysis (modes, frf or static)");
+      if (std::find(known.begin(), known.end(), k) == known.end()) {
+        std::string hint = suggestion(k, known);
+        if (hint.empty()) hint = " (one of: " + join(known) + ")";
+        fail(an, "unknown analysis '" + k + "' in " + what + hint);
+      }
+      if (auto [at, inserted] = seen.emplace(k, loc(an)); !inserted)
+        fail(an, "'" + k + "' is listed twice in " + what + " (first at " + at->second.str() + ")");
+      s.analyses.push_back(k == "modes" ? Analysis::modes : k == "frf" ? Analysis::frf : Analysis::statics);
+    }
+    if (s.analyses.empty()) fail(a->key, what + " asks for no analysis (modes, frf, static)");
+  }
+  if (const Entry* e = find(f, "effects")) s.effects = items(*e, "the effects of " + what);
+  if (const Entry* e = find(f, "without")) s.without = items(*e, "the effects " + what + " is without");
+  if (const Entry* e = find(f, "inputs")) s.inputs = items(*e, "the inputs of " + what);
+  if (const Entry* e = find(f, "outputs")) s.outputs = items(*e, "the outputs of " + what);
+  if (const Entry* op = find(f, "operating_point"))
+    s.operating_point = read_operating_point_values(value(*op), "the operating point of " + what);
+  if (const Entry* fr = find(f, "frequency_range")) {
+    const YAML::Node& fn = value(*fr);
+    const Fields g = fields(fn, "a frequency range", {"from", "to", "points", "spacing"});
+    FrequencyRange range;
+    range.where = loc(fn);
+    auto hz = [&](const char* key) {
+      const Entry& e = require(g, key, fn, "a frequency range");
+      const GiNaC::ex v = GiNaC::evalf(expr(e, std::string("a frequency (Hz)"), Scope::constants));
+      if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real())
+        fail(value(e), "a frequency must be a real number (Hz)");
+      return GiNaC::ex_to<GiNaC::numeric>(v).to_double();
+    };
+    range.from_hz = hz("from");
+    range.to_hz = hz("to");
+    if (const Entry* p = find(g, "points")) {
+      const YAML::Node& pn = value(*p);
+      const std::string t = scalar(pn, "a number of points");
+      std::size_t used = 0;
+      long k = 0;
+      try {
+        k = std::stol(t, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != t.size() || k < 2 || k > 10000000)
+        fail(pn, "the number of points must be an integer from 2 to 10000000, got '" + t + "'");
+      range.points = static_cast<int>(k);
+    }
+    if (const Entry* sp = find(g, "spacing")) {
+      const YAML::Node& sn = value(*sp);
+      const std::string t = scalar(sn, "a spacing (log or linear)");
+      if (t == "log") range.logarithmic = true;
+      else if (t == "linear") range.logarithmic = false;
+      else fail(sn, "unknown spacing '" + t + "' (log or linear)");
+    }
+    if (!(range.to_hz > range.from_hz) || range.from_hz < 0)
+      fail(fn, "a frequency range needs 0 <= from < to (Hz)");
+    if (range.logarithmic && !(range.from_hz > 0))
+      fail(fn, "a logarithmic frequency range needs from > 0 (or spacing: linear)");
+    s.frequency_range = range;
+  }
+  model_->add_scene(s);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The mbsgen command: check, info and generate a model; `mbsgen linear` analyses raw matrices.
 // Exit codes: 0 success, 1 a bad model or failed analysis, 2 a usage error.
 #include "mbsgen/generator/emit.hpp"
+#include "mbsgen/generator/scene.hpp"
 #include "mbsgen/generator/yaml_reader.hpp"
 
 #include <CLI/CLI.hpp>
@@ -8,6 +9,8 @@
 #include <chrono>
 #include <cstring>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #ifdef MBSGEN_HAVE_LINEAR_CLI
 namespace mbsgen::cli {
@@ -17,8 +20,22 @@ int linear_main(int argc, char** argv);
 
 namespace {
 
-int print_info(const mbsgen::Model& model, const mbsgen::GeneratedCode& code, double seconds) {
+// `model` is the scene's pruned model; `scenes` the scenes of the model file.
+int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& scenes,
+               const mbsgen::LinearEquations& lin, const mbsgen::GeneratedCode& code, double seconds) {
+  const mbsgen::SceneSelection& scene = model.selection();
   std::cout << "model " << model.name() << "\n";
+  std::cout << "scenes: full (implicit)";
+  for (const auto& s : scenes) std::cout << ", " << s.name;
+  std::cout << "\nscene " << scene.name << (scene.description.empty() ? "" : ": " + scene.description)
+            << "\n  analyses:";
+  for (auto a : scene.analyses) std::cout << " " << mbsgen::to_string(a);
+  std::cout << "\n  effects:\n";
+  for (const auto& e : scene.effects)
+    std::cout << "    " << (e.active ? "on  " : "off ") << e.name << " (" << e.category << ")"
+              << (e.note.empty() ? "" : ": " + e.note) << "\n";
+  std::cout << "  structure: D " << (lin.D_zero ? "zero" : "nonzero") << ", G "
+            << (lin.G_zero ? "zero" : "nonzero") << ", N " << (lin.N_zero ? "zero" : "nonzero") << "\n";
   std::cout << "bodies (" << model.bodies().size() << "):";
   for (const auto& b : model.bodies()) std::cout << " " << b.name << "<-" << b.parent;
   std::cout << "\ncoordinates (" << model.coordinates().size() << "):";
@@ -46,13 +63,15 @@ int main(int argc, char** argv) {
   bool no_cse = false;
   auto* check = app.add_subcommand("check", "read and validate a model file");
   check->add_option("MODEL", model_file, "model file (YAML)")->required();
-  auto* info = app.add_subcommand("info", "bodies, coordinates, kernels and operation counts");
+  auto* info = app.add_subcommand("info", "scenes, effects, kernels and operation counts");
   info->add_option("MODEL", model_file, "model file (YAML)")->required();
+  info->add_option("--scene", scene, "scene to describe (default: the full model)");
   auto* generate = app.add_subcommand("generate", "emit C++ kernels and a JSON manifest");
   generate->add_option("MODEL", model_file, "model file (YAML)")->required();
   generate->add_option("--out", out_dir, "output directory")->required();
   generate->add_option("--scene", scene, "scene to generate (default: the full model)");
-  generate->add_option("--id", id, "C identifier prefix of the kernels (default: the model name)");
+  generate->add_option("--id", id, "C identifier prefix of the kernels (default: the model name, "
+                                   "MODEL_SCENE for a scene)");
   generate->add_flag("--no-cse", no_cse, "skip common-subexpression elimination");
   app.add_subcommand("linear", "modes and frequency responses of raw matrices (mbsgen linear --help)");
   try {
@@ -68,21 +87,16 @@ int main(int argc, char** argv) {
                 << model.coordinates().size() << " coordinates)\n";
       return 0;
     }
-    if (scene != "full") {
-      std::cerr << "mbsgen: error: model '" << model.name() << "' has no scene '" << scene
-                << "' (scenes: full)\n";
-      return 1;
-    }
-    mbsgen::Equations eq = mbsgen::derive(model);
+    const mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
+    mbsgen::Equations eq = mbsgen::derive(pruned);
     mbsgen::LinearEquations lin = mbsgen::linearize(eq);
     mbsgen::EmitOptions options;
     options.cse = !no_cse;
-    options.scene = scene;
     options.source_file = model_file;
     options.id = id;
-    mbsgen::GeneratedCode code = mbsgen::emit(model, eq, lin, options);
+    mbsgen::GeneratedCode code = mbsgen::emit(pruned, eq, lin, options);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (*info) return print_info(model, code, seconds);
+    if (*info) return print_info(pruned, model.scenes(), lin, code, seconds);
     mbsgen::write_generated(code, out_dir);
     std::cerr << "mbsgen: wrote " << out_dir << "/" << code.id << ".{hpp,cpp,json} in " << seconds
               << " s\n";

@@ -1,7 +1,12 @@
-# Generates MODEL three times into separate directories (separate processes, so GiNaC's
-# address-seeded hashes differ) and fails unless the files are byte-identical.
+# Generates MODEL (or its scene SCENE) three times into separate directories (separate
+# processes, so GiNaC's address-seeded hashes differ) and fails unless the files are
+# byte-identical.
+set(_scene)
+if(DEFINED SCENE)
+  set(_scene --scene ${SCENE})
+endif()
 foreach(_run a b c)
-  execute_process(COMMAND ${MBSGEN} generate ${MODEL} --id det --out ${OUT}/${_run}
+  execute_process(COMMAND ${MBSGEN} generate ${MODEL} ${_scene} --id det --out ${OUT}/${_run}
                   RESULT_VARIABLE _rc)
   if(NOT _rc EQUAL 0)
     message(FATAL_ERROR "mbsgen generate failed (${_rc})")

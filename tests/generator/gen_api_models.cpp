@@ -1,19 +1,22 @@
-// Writes the generated kernels of a model built through the C++ API (chain.hpp):
-//   gen_api_models planar|spatial N ID OUT_DIR
+// Writes the generated kernels of a model built through the C++ API (chain.hpp), for its full
+// model or one of its scenes:
+//   gen_api_models planar|spatial N ID OUT_DIR [SCENE]
 #include "mbsgen/generator/chain.hpp"
 #include "mbsgen/generator/emit.hpp"
+#include "mbsgen/generator/scene.hpp"
 
 #include <iostream>
 #include <string>
 
 int main(int argc, char** argv) {
-  if (argc != 5) {
-    std::cerr << "usage: gen_api_models planar|spatial N ID OUT_DIR\n";
+  if (argc != 5 && argc != 6) {
+    std::cerr << "usage: gen_api_models planar|spatial N ID OUT_DIR [SCENE]\n";
     return 2;
   }
   const std::string kind = argv[1];
   const int n = std::stoi(argv[2]);
-  mbsgen::Model model = kind == "planar" ? mbsgen::planar_chain(n) : mbsgen::spatial_chain(n);
+  const mbsgen::Model chain = kind == "planar" ? mbsgen::planar_chain(n) : mbsgen::spatial_chain(n);
+  const mbsgen::Model model = mbsgen::apply_scene(chain, argc == 6 ? argv[5] : mbsgen::kFullScene);
   mbsgen::Equations eq = mbsgen::derive(model);
   mbsgen::LinearEquations lin = mbsgen::linearize(eq);
   mbsgen::EmitOptions options;

@@ -49,24 +49,7 @@ Linear linear_at_default(const GeneratedModel& g) {
   return L;
 }
 
-// Eigenvalues of λ²M + λQ + K through the companion matrix of the problem scaled as Fan, Lin
-// & Van Dooren (2004) propose, λ = γμ with γ = √(‖K‖/‖M‖), so that the companion matrix is well
-// balanced (M is well conditioned in every textbook case; the runtime's QZ solver is tested
-// separately).
-std::vector<cplx> eigenvalues(const Linear& L) {
-  const Eigen::Index n = L.M.rows();
-  const double nk = L.K.norm(), nm = L.M.norm();
-  const double gamma = nk > 0 ? std::sqrt(nk / nm) : 1.0;
-  MatrixXd A = MatrixXd::Zero(2 * n, 2 * n);
-  A.topRightCorner(n, n).setIdentity();
-  Eigen::PartialPivLU<MatrixXd> lu(L.M);
-  A.bottomLeftCorner(n, n) = -lu.solve(L.K) / (gamma * gamma);
-  A.bottomRightCorner(n, n) = -lu.solve(L.Q) / gamma;
-  Eigen::EigenSolver<MatrixXd> es(A, false);
-  std::vector<cplx> ev;
-  for (Eigen::Index i = 0; i < 2 * n; ++i) ev.push_back(gamma * es.eigenvalues()[i]);
-  return ev;
-}
+std::vector<cplx> eigenvalues(const Linear& L) { return quadratic_eigenvalues(L.M, L.Q, L.K); }
 
 double max_abs(const MatrixXd& A) { return A.size() ? A.cwiseAbs().maxCoeff() : 0.0; }
 

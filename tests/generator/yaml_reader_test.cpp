@@ -148,9 +148,44 @@ TEST(ChainSympy, DecimalValuesAreExactInExpressionsAndRoundedAsParameters) {
   EXPECT_EQ(m.parameters()[1].value, 1.5);
   EXPECT_EQ(m.parameters()[9].name, "c1");
   EXPECT_EQ(m.parameters()[9].value, 0.1);  // the double nearest to 1/10
-  ASSERT_EQ(m.generalized_forces().size(), 3u);
-  EXPECT_TRUE(same(m.generalized_forces()[0].value,
-                   -m.symbol("k1") * m.symbol("q1") - m.symbol("c1") * m.symbol("q1_dot")));
+  ASSERT_EQ(m.generalized_forces().size(), 6u);
+  EXPECT_TRUE(same(m.generalized_forces()[0].value, -m.symbol("k1") * m.symbol("q1")));
+  EXPECT_EQ(m.generalized_forces()[0].category, mbsgen::Category::springs);
+  EXPECT_TRUE(same(m.generalized_forces()[3].value, -m.symbol("c1") * m.symbol("q1_dot")));
+  EXPECT_EQ(m.generalized_forces()[3].category, mbsgen::Category::dampers);
+}
+
+TEST(Scenes, ReadAsWritten) {
+  const mbsgen::Model m = mbsgen::read_model_file(kSourceDir + "/models/textbook/rotor_disk.yaml");
+  ASSERT_EQ(m.scenes().size(), 2u);
+  const mbsgen::Scene& rest = m.scenes()[0];
+  EXPECT_EQ(rest.name, "modes_at_rest");
+  EXPECT_EQ(rest.description, "natural frequencies of the disk at standstill");
+  ASSERT_EQ(rest.analyses.size(), 1u);
+  EXPECT_EQ(rest.analyses[0], mbsgen::Analysis::modes);
+  EXPECT_FALSE(rest.effects.has_value());
+  EXPECT_TRUE(rest.without.empty());
+  EXPECT_FALSE(rest.inputs.has_value());
+  EXPECT_TRUE(rest.operating_point.position.empty());
+  EXPECT_FALSE(rest.operating_point.kind.has_value());
+  ASSERT_EQ(rest.operating_point.velocity.count("gamma"), 1u);
+  EXPECT_TRUE(rest.operating_point.velocity.at("gamma").is_zero());
+  EXPECT_FALSE(rest.frequency_range.has_value());
+  const mbsgen::Scene& spin = m.scenes()[1];
+  EXPECT_EQ(spin.name, "spinning");
+  ASSERT_EQ(spin.analyses.size(), 2u);
+  EXPECT_EQ(spin.analyses[1], mbsgen::Analysis::frf);
+  ASSERT_TRUE(spin.inputs.has_value());
+  ASSERT_EQ(spin.inputs->size(), 1u);
+  EXPECT_EQ((*spin.inputs)[0].name, "T");
+  EXPECT_GT((*spin.inputs)[0].where.line, 0);
+  ASSERT_TRUE(spin.outputs.has_value());
+  EXPECT_EQ((*spin.outputs)[0].name, "tilt_x");
+  ASSERT_TRUE(spin.frequency_range.has_value());
+  EXPECT_EQ(spin.frequency_range->from_hz, 1.0);
+  EXPECT_EQ(spin.frequency_range->to_hz, 100.0);
+  EXPECT_EQ(spin.frequency_range->points, 400);
+  EXPECT_TRUE(spin.frequency_range->logarithmic);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -351,6 +386,34 @@ TEST(Errors, ApplicationSpecificKeysAreRejectedPerType) {
                             "outputs:\n  - {name: o, type: coordinate, coordinate: x, marker: p}\n"),
             "test.yaml:8:48: error: unknown key 'marker' in a coordinate output (allowed: name, "
             "type, unit, coordinate)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scenes
+
+TEST(Scenes, DefaultsOfAMinimalScene) {
+  const mbsgen::Model m = mbsgen::read_model_string(std::string(kBlock) + "scenes:\n  - {name: s}\n", "s.yaml");
+  ASSERT_EQ(m.scenes().size(), 1u);
+  const mbsgen::Scene& s = m.scenes()[0];
+  EXPECT_EQ(s.analyses.size(), 3u);
+  EXPECT_FALSE(s.effects.has_value());
+  EXPECT_FALSE(s.inputs.has_value());
+  EXPECT_FALSE(s.outputs.has_value());
+  EXPECT_EQ(s.where.line, 8);
+  EXPECT_EQ(s.where.column, 5);
+}
+
+TEST(Scenes, ErrorsInFrequencyRanges) {
+  const std::string head = std::string(kBlock) + "scenes:\n  - name: s\n    frequency_range: ";
+  EXPECT_EQ(error_of_string(head + "{from: 0, to: 10}\n"),
+            "test.yaml:9:22: error: a logarithmic frequency range needs from > 0 (or spacing: linear)");
+  EXPECT_EQ(error_of_string(head + "{from: 0, to: 10, spacing: linear}\n"), "");
+  EXPECT_EQ(error_of_string(head + "{from: 1, to: 10, points: 1}\n"),
+            "test.yaml:9:48: error: the number of points must be an integer from 2 to 10000000, got '1'");
+  EXPECT_EQ(error_of_string(head + "{from: 1, to: k}\n"),
+            "test.yaml:9:36: error: a frequency (Hz) must be a constant (numbers, Pi and functions only); "
+            "'k' is a parameter");
+  EXPECT_EQ(error_of_string(head + "{from: 1}\n"), "test.yaml:9:22: error: a frequency range needs the key 'to'");
 }
 
 }  // namespace

@@ -30,7 +30,9 @@ struct Equations {
   ExMatrix JT, JR;                          ///< per body 3×f: centre-of-mass and angular Jacobians
 };
 
-/// Derives the equations of a validated model.
+/// Derives the equations of a validated model. When model.inertial_velocity_terms() is false
+/// (a scene that drops them), k(y, ẏ) has no velocity-quadratic inertia terms: the residual is
+/// then exact at ẏ = 0 only.
 Equations derive(const Model& model);
 
 }  // namespace mbsgen

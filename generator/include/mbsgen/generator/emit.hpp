@@ -6,6 +6,7 @@
 #pragma once
 
 #include "mbsgen/generator/linearize.hpp"
+#include "mbsgen/generator/scene.hpp"
 
 #include <string>
 #include <vector>
@@ -17,9 +18,13 @@ inline constexpr const char* kGeneratorVersion = "0.1.0";
 
 struct EmitOptions {
   bool cse = true;
-  std::string scene = "full";
+  /// The scene's name: empty, or the name of model.selection() (apply_scene); anything else is
+  /// an error. The scene itself (kernels, effects) is the one the model was pruned for.
+  std::string scene;
   std::string source_file;  ///< shown in the header; the model file as given
-  std::string id;           ///< C identifier prefix of the kernels (default: from the model name)
+  /// C identifier prefix of the kernels (default: the model name, and `<model>_<scene>` for a
+  /// scene other than "full").
+  std::string id;
 };
 
 struct KernelInfo {
@@ -34,6 +39,10 @@ struct GeneratedCode {
   std::vector<KernelInfo> kernels;
 };
 
+/// Emits the kernels model.selection().kernels of the derived and linearized model. The header
+/// defines `<id>_HAS_<KERNEL>` (e.g. `<id>_HAS_LINEAR`) for each emitted kernel and declares
+/// only those; the manifest lists the scene's analyses, effects, kernels with their operation
+/// counts, and whether D, G and N are structurally zero.
 GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin,
                    const EmitOptions& options = {});
 

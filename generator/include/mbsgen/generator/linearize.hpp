@@ -17,8 +17,14 @@ struct LinearEquations {
   ExMatrix D, G, Ks, N;         ///< sym Q, skew Q, sym K, skew K
   std::vector<GiNaC::ex> y0, yd0;  ///< default operating point (expressions in p)
   bool equilibrium = false;     ///< y0 is an initial guess for a static equilibrium
+  /// D, G, N vanish at the operating point for all parameter values (the manifest's
+  /// "structure"). Where they vanish for all arguments (y0, ẏ0, p) of the kernels they are
+  /// exact zeros, and Q and K exactly symmetric or skew (each pair of entries computed once).
+  bool D_zero = false, G_zero = false, N_zero = false;
 };
 
+/// Linearizes about the model's operating point. Whether D, G, N vanish is decided by
+/// evaluating them at two pseudo-random points with 50 digits (linearize.cpp).
 LinearEquations linearize(Equations& eq);
 
 }  // namespace mbsgen

@@ -117,12 +117,23 @@ struct Bushing {
   SourceLocation where;
 };
 
+/// The kinds of effect a scene can switch on and off (docs/model-format.md, "scenes"):
+/// gravity elements; springs (and the stiffness of bushings); dampers (and the damping of
+/// bushings); the velocity-quadratic inertia terms (gyroscopic, centrifugal and Coriolis forces);
+/// generalized forces; applied forces.
+enum class Category { gravity, springs, dampers, gyroscopic, generalized, applied };
+
+/// "gravity", "springs", "dampers", "gyroscopic", "generalized", "applied".
+const char* to_string(Category category);
+
 /// A generalized force on one coordinate (may depend on coordinates, rates and inputs).
 struct GeneralizedForce {
   std::string name;
   std::string coordinate;
   GiNaC::ex value;
   SourceLocation where;
+  /// The category scenes select it by: generalized (the default), springs or dampers.
+  Category category = Category::generalized;
 };
 
 enum class ForceFrame { world, marker };
@@ -169,6 +180,92 @@ struct OperatingPoint {
   SourceLocation where;
 };
 
+/// An analysis a scene asks for; it decides which kernels are emitted.
+enum class Analysis {
+  modes,  ///< eigenvalues of λ²M + λQ + K: kernels linear and linear_structured
+  frf,    ///< frequency responses: kernel linear (M, Q, K, B, C)
+  statics ///< static equilibrium by Newton's method: kernels residual and linear (K)
+};
+
+/// "modes", "frf", "static".
+const char* to_string(Analysis analysis);
+
+/// A name written in a scene, with its place in the model file.
+struct SceneItem {
+  std::string name;
+  SourceLocation where;
+};
+
+/// Default frequency range of a scene's frequency responses [Hz].
+struct FrequencyRange {
+  double from_hz = 1;
+  double to_hz = 1000;
+  int points = 200;
+  bool logarithmic = true;
+  SourceLocation where;
+};
+
+/// Changes a scene makes to the model's operating point: the given entries replace the model's
+/// (per coordinate); the rest are kept.
+struct OperatingPointOverride {
+  std::optional<OperatingPoint::Kind> kind;
+  std::map<std::string, GiNaC::ex> position;
+  std::map<std::string, GiNaC::ex> velocity;
+  SourceLocation where;
+};
+
+/// A named analysis request (docs/model-format.md, "scenes"): the active effects, the operating
+/// point, the analyses and the inputs and outputs of interest. apply_scene() (scene.hpp) turns a
+/// model and one of its scenes into the pruned model that the generator derives.
+struct Scene {
+  std::string name;
+  std::string description;
+  /// Active effects: force element names or categories (to_string(Category)); all when absent.
+  std::optional<std::vector<SceneItem>> effects;
+  /// Effects removed from the active ones (names or categories).
+  std::vector<SceneItem> without;
+  /// Inputs of interest, in the order of B's columns. When absent: every input if the scene asks
+  /// for frf or static, none otherwise. Inputs not listed are set to zero.
+  std::optional<std::vector<SceneItem>> inputs;
+  /// Outputs of interest, in the order of C's rows. When absent: every output if the scene asks
+  /// for frf, none otherwise.
+  std::optional<std::vector<SceneItem>> outputs;
+  std::vector<Analysis> analyses = {Analysis::modes, Analysis::frf, Analysis::statics};
+  OperatingPointOverride operating_point;
+  std::optional<FrequencyRange> frequency_range;
+  SourceLocation where;
+};
+
+/// The name of the implicit scene that is the whole model.
+inline const char* const kFullScene = "full";
+
+/// What a scene made of one effect: a force element (a bushing has a springs and a dampers
+/// part), the inertia terms ("gyroscopic"), or an input (category "inputs").
+struct EffectState {
+  std::string name;
+  std::string category;  ///< to_string(Category), or "inputs"
+  bool active = true;
+  std::string note;  ///< why an effect the scene did not switch off is inactive, or ""
+};
+
+/// A scene resolved against its model (apply_scene in scene.hpp): what the emitter writes.
+struct SceneSelection {
+  std::string name = kFullScene;
+  std::string description;
+  bool full = true;  ///< the implicit full scene: every kernel, nothing pruned
+  std::vector<Analysis> analyses = {Analysis::modes, Analysis::frf, Analysis::statics};
+  /// The kernels to emit, in emission order (names as in docs/generator.md).
+  std::vector<std::string> kernels = all_kernels();
+  /// Every effect of the original model and whether the scene keeps it (empty for the full
+  /// model: everything is active).
+  std::vector<EffectState> effects;
+  std::optional<FrequencyRange> frequency_range;
+
+  /// mass_matrix, residual, linear, linear_structured, operating_point, outputs, bodies.
+  static std::vector<std::string> all_kernels();
+  bool emits(const std::string& kernel) const;
+};
+
 struct Parameter {
   std::string name;
   double value = 0;  ///< SI default
@@ -185,6 +282,10 @@ struct Coordinate {
   GiNaC::symbol velocity;  ///< ẏ_k, written `NAME_dot` in expressions
   SourceLocation where;
 };
+
+class Model;
+/// The model as one of its scenes sees it (scene.hpp).
+Model apply_scene(const Model& model, const std::string& scene);
 
 /// A multibody model. Add parameters, coordinates and inputs first (they create the symbols that
 /// expressions use), then bodies, markers, forces and outputs. `validate()` checks the whole.
@@ -211,6 +312,12 @@ class Model {
   void add_applied_force(AppliedForce force);
   void add_output(Output output);
   void set_operating_point(OperatingPoint op) { operating_point_ = std::move(op); }
+  /// Adds a scene; its references are checked by validate().
+  void add_scene(Scene scene);
+  /// False drops the velocity-quadratic inertia terms (gyroscopic, centrifugal and Coriolis
+  /// forces) from k(y, ẏ); apply_scene() does so when a scene deactivates them or linearizes
+  /// about rest, where they cannot contribute.
+  void set_inertial_velocity_terms(bool on) { inertial_velocity_terms_ = on; }
 
   /// Symbol of a parameter, coordinate (position), coordinate rate (`NAME_dot`) or input.
   GiNaC::ex symbol(const std::string& name) const;
@@ -231,6 +338,12 @@ class Model {
   const std::vector<AppliedForce>& applied_forces() const { return applied_forces_; }
   const std::vector<Output>& outputs() const { return outputs_; }
   const OperatingPoint& operating_point() const { return operating_point_; }
+  const std::vector<Scene>& scenes() const { return scenes_; }
+  /// The scene of that name, or nullptr (also for the implicit "full").
+  const Scene* scene(const std::string& name) const;
+  bool inertial_velocity_terms() const { return inertial_velocity_terms_; }
+  /// The scene this model was pruned for by apply_scene() (the full scene otherwise).
+  const SceneSelection& selection() const { return selection_; }
 
   /// Index of a body (kWorld → -1); throws std::out_of_range for unknown names.
   int body_index(const std::string& name) const;
@@ -240,11 +353,13 @@ class Model {
   bool has_marker(const std::string& name) const;
 
   /// Checks references (parents, markers, coordinates), the tree (no cycles, every body reaches
-  /// the world), masses and inertias, and that every expression uses only known symbols.
-  /// Throws ModelError at the offending element.
+  /// the world), masses and inertias, that every expression uses only known symbols, and every
+  /// scene (check_scene in scene.hpp). Throws ModelError at the offending element.
   void validate() const;
 
  private:
+  friend Model apply_scene(const Model& model, const std::string& scene);
+
   void check_new_symbol(const std::string& name, const SourceLocation& where);
   void check_new_element(const std::string& name, const char* kind, const SourceLocation& where);
 
@@ -264,6 +379,9 @@ class Model {
   std::vector<AppliedForce> applied_forces_;
   std::vector<Output> outputs_;
   OperatingPoint operating_point_;
+  std::vector<Scene> scenes_;
+  bool inertial_velocity_terms_ = true;
+  SceneSelection selection_;
   std::map<std::string, int> body_index_;
   std::map<std::string, int> marker_index_;
   std::map<std::string, SourceLocation> symbol_names_;  // parameters, coordinates, rates, inputs

@@ -10,6 +10,7 @@
 #include "mbsgen/generator/model.hpp"
 
 #include <string>
+#include <vector>
 
 namespace mbsgen {
 
@@ -44,6 +45,10 @@ class ExpressionError : public std::runtime_error {
 
 /// Edit distance (insertions, deletions, substitutions, adjacent transpositions).
 std::size_t edit_distance(const std::string& a, const std::string& b);
+
+/// " (did you mean 'x'?)" for the candidate closest to `word` within a small edit distance
+/// (1 for words up to 3 letters, 2 up to 6, else 3), or "" when there is none.
+std::string suggestion(const std::string& word, const std::vector<std::string>& candidates);
 
 }  // namespace detail
 

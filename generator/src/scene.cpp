@@ -1,0 +1,379 @@
+#include "mbsgen/generator/scene.hpp"
+
+#include "mbsgen/generator/yaml_reader.hpp"
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+namespace mbsgen {
+
+using GiNaC::ex;
+
+std::vector<std::string> SceneSelection::all_kernels() {
+  return {"mass_matrix", "residual", "linear", "linear_structured", "operating_point", "outputs", "bodies"};
+}
+
+bool SceneSelection::emits(const std::string& kernel) const {
+  return std::find(kernels.begin(), kernels.end(), kernel) != kernels.end();
+}
+
+std::vector<std::string> kernels_of(Analysis analysis) {
+  switch (analysis) {
+    case Analysis::modes: return {"linear", "linear_structured"};
+    case Analysis::frf: return {"linear"};
+    case Analysis::statics: return {"residual", "linear"};
+  }
+  return {};
+}
+
+namespace {
+
+const Category kCategories[] = {Category::gravity,    Category::springs,     Category::dampers,
+                                Category::gyroscopic, Category::generalized, Category::applied};
+
+std::vector<std::string> category_names() {
+  std::vector<std::string> names;
+  for (Category c : kCategories) names.push_back(to_string(c));
+  return names;
+}
+
+std::string join(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+bool nonzero(const Vec3& v) { return !v[0].is_zero() || !v[1].is_zero() || !v[2].is_zero(); }
+
+// One force element, or one part of a bushing, as an effect.
+struct ForceEffect {
+  std::string name;
+  Category category;
+};
+
+std::vector<ForceEffect> force_effects(const Model& m) {
+  std::vector<ForceEffect> out;
+  for (const auto& g : m.gravity()) out.push_back({g.name, Category::gravity});
+  for (const auto& s : m.springs()) out.push_back({s.name, Category::springs});
+  for (const auto& d : m.dampers()) out.push_back({d.name, Category::dampers});
+  for (const auto& b : m.bushings()) {
+    if (nonzero(b.k_translation) || nonzero(b.k_rotation)) out.push_back({b.name, Category::springs});
+    if (nonzero(b.d_translation) || nonzero(b.d_rotation)) out.push_back({b.name, Category::dampers});
+  }
+  for (const auto& g : m.generalized_forces()) out.push_back({g.name, g.category});
+  for (const auto& a : m.applied_forces()) out.push_back({a.name, Category::applied});
+  return out;
+}
+
+std::set<std::string> force_names(const Model& m) {
+  std::set<std::string> names;
+  for (const auto& f : force_effects(m)) names.insert(f.name);
+  // Bushings without stiffness or damping are still force elements a scene may name.
+  for (const auto& b : m.bushings()) names.insert(b.name);
+  return names;
+}
+
+// What a name that is not an effect is, for the message ("a body", …), or "".
+std::string kind_of(const Model& m, const std::string& name) {
+  for (const auto& b : m.bodies())
+    if (b.name == name) return "a body";
+  if (m.has_marker(name)) return "a marker";
+  for (const auto& o : m.outputs())
+    if (o.name == name) return "an output";
+  for (const auto& c : m.coordinates())
+    if (c.name == name || c.name + "_dot" == name) return "a coordinate";
+  for (const auto& p : m.parameters())
+    if (p.name == name) return "a parameter";
+  return "";
+}
+
+void collect_symbols(const ex& e, std::set<std::string>& out) {
+  if (GiNaC::is_a<GiNaC::symbol>(e)) {
+    out.insert(GiNaC::ex_to<GiNaC::symbol>(e).get_name());
+    return;
+  }
+  for (std::size_t i = 0; i < e.nops(); ++i) collect_symbols(e.op(i), out);
+}
+
+// Throws when an item of `items` was listed before.
+void check_unique(const std::vector<SceneItem>& items, const std::string& scene,
+                  std::map<std::string, SourceLocation>& seen) {
+  for (const auto& it : items) {
+    auto [at, inserted] = seen.emplace(it.name, it.where);
+    if (!inserted)
+      throw ModelError(it.where, "'" + it.name + "' is listed twice in scene '" + scene +
+                                     "' (first at " + at->second.str() + ")");
+  }
+}
+
+}  // namespace
+
+void check_scene(const Model& model, const Scene& scene) {
+  const std::string in_scene = " in scene '" + scene.name + "'";
+  const std::set<std::string> forces = force_names(model);
+  const std::vector<std::string> categories = category_names();
+  std::vector<std::string> effect_names(categories);
+  effect_names.insert(effect_names.end(), forces.begin(), forces.end());
+
+  auto check_effect = [&](const SceneItem& it) {
+    if (forces.count(it.name) ||
+        std::find(categories.begin(), categories.end(), it.name) != categories.end())
+      return;
+    for (const auto& i : model.inputs())
+      if (i.name == it.name)
+        throw ModelError(it.where, "'" + it.name + "' is an input, not an effect: list it under 'inputs'" +
+                                       in_scene);
+    std::string message = "unknown effect '" + it.name + "'" + in_scene;
+    const std::string hint = detail::suggestion(it.name, effect_names);
+    const std::string kind = kind_of(model, it.name);
+    if (!hint.empty())
+      message += hint;
+    else if (!kind.empty())
+      message = "'" + it.name + "' is " + kind + ", not an effect" + in_scene;
+    if (hint.empty())
+      message += " (effects: the force elements by name and the categories " + join(categories) + ")";
+    throw ModelError(it.where, message);
+  };
+  std::map<std::string, SourceLocation> seen;
+  if (scene.effects) {
+    for (const auto& it : *scene.effects) check_effect(it);
+    check_unique(*scene.effects, scene.name, seen);
+  }
+  for (const auto& it : scene.without) check_effect(it);
+  check_unique(scene.without, scene.name, seen);
+
+  auto check_names = [&](const std::vector<SceneItem>& items, const char* what,
+                         const std::vector<std::string>& known) {
+    for (const auto& it : items) {
+      if (std::find(known.begin(), known.end(), it.name) != known.end()) continue;
+      std::string hint = detail::suggestion(it.name, known);
+      if (hint.empty())
+        hint = known.empty() ? std::string(" (the model has no ") + what + "s)"
+                             : std::string(" (") + what + "s: " + join(known) + ")";
+      throw ModelError(it.where, std::string("unknown ") + what + " '" + it.name + "'" + in_scene + hint);
+    }
+    std::map<std::string, SourceLocation> once;
+    check_unique(items, scene.name, once);
+  };
+  if (scene.inputs) {
+    std::vector<std::string> known;
+    for (const auto& i : model.inputs()) known.push_back(i.name);
+    check_names(*scene.inputs, "input", known);
+  }
+  if (scene.outputs) {
+    std::vector<std::string> known;
+    for (const auto& o : model.outputs()) known.push_back(o.name);
+    check_names(*scene.outputs, "output", known);
+  }
+
+  std::set<std::string> parameters;
+  for (const auto& p : model.parameters()) parameters.insert(p.name);
+  const OperatingPointOverride& op = scene.operating_point;
+  for (const auto* values : {&op.position, &op.velocity})
+    for (const auto& [name, value] : *values) {
+      if (model.coordinate_index(name) < 0)
+        throw ModelError(op.where, "the operating point of scene '" + scene.name +
+                                       "' names an unknown coordinate '" + name + "'");
+      std::set<std::string> syms;
+      collect_symbols(value, syms);
+      for (const auto& s : syms)
+        if (!parameters.count(s))
+          throw ModelError(op.where, "an operating point may depend on parameters only; '" + s +
+                                         "' is not a parameter");
+    }
+
+  if (scene.analyses.empty())
+    throw ModelError(scene.where, "scene '" + scene.name + "' asks for no analysis (modes, frf, static)");
+  for (std::size_t i = 0; i < scene.analyses.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (scene.analyses[i] == scene.analyses[j])
+        throw ModelError(scene.where, std::string("analysis '") + to_string(scene.analyses[i]) +
+                                          "' is listed twice" + in_scene);
+  if (const auto& f = scene.frequency_range) {
+    if (!(f->from_hz >= 0) || !(f->to_hz > f->from_hz))
+      throw ModelError(f->where, "a frequency range needs 0 <= from < to (Hz)");
+    if (f->logarithmic && !(f->from_hz > 0))
+      throw ModelError(f->where, "a logarithmic frequency range needs from > 0");
+    if (f->points < 2) throw ModelError(f->where, "a frequency range needs at least 2 points");
+  }
+}
+
+std::vector<EffectState> effects_of(const Model& model) {
+  std::vector<EffectState> effects;
+  for (const auto& f : force_effects(model)) effects.push_back({f.name, to_string(f.category), true, ""});
+  effects.push_back({"gyroscopic", to_string(Category::gyroscopic), model.inertial_velocity_terms(), ""});
+  for (const auto& i : model.inputs()) effects.push_back({i.name, "inputs", true, ""});
+  return effects;
+}
+
+Model apply_scene(const Model& model, const std::string& name) {
+  const Scene* scene = model.scene(name);
+  if (!scene && name != kFullScene) {
+    std::vector<std::string> names = {kFullScene};
+    for (const auto& s : model.scenes()) names.push_back(s.name);
+    throw std::invalid_argument("model '" + model.name() + "' has no scene '" + name + "'" +
+                                detail::suggestion(name, names) + " (scenes: " + join(names) + ")");
+  }
+  Model m = model;
+  m.scenes_.clear();
+  m.selection_ = SceneSelection{};
+  SceneSelection& sel = m.selection_;
+  if (!scene) {  // the full model: every effect, input, output and kernel
+    sel.effects = effects_of(model);
+    return m;
+  }
+  check_scene(model, *scene);
+  sel.name = scene->name;
+  sel.description = scene->description;
+  sel.full = false;
+  sel.analyses = scene->analyses;
+  sel.frequency_range = scene->frequency_range;
+  auto asks = [&](Analysis a) {
+    return std::find(sel.analyses.begin(), sel.analyses.end(), a) != sel.analyses.end();
+  };
+  sel.kernels.clear();
+  for (const auto& k : SceneSelection::all_kernels()) {
+    bool used = k == "operating_point";
+    for (Analysis a : sel.analyses) {
+      const auto ks = kernels_of(a);
+      used = used || std::find(ks.begin(), ks.end(), k) != ks.end();
+    }
+    if (used) sel.kernels.push_back(k);
+  }
+
+  // The operating point, overridden per coordinate.
+  const OperatingPointOverride& op = scene->operating_point;
+  if (op.kind) m.operating_point_.kind = *op.kind;
+  for (const auto& [c, v] : op.position) m.operating_point_.position[c] = v;
+  for (const auto& [c, v] : op.velocity) m.operating_point_.velocity[c] = v;
+  if (op.where.line > 0) m.operating_point_.where = op.where;
+  bool at_rest = true;
+  for (const auto& [c, v] : m.operating_point_.velocity) at_rest = at_rest && v.is_zero();
+
+  // Which effects are active: named (by force name, else by category) in `effects` (all when
+  // absent), and not in `without`.
+  const std::set<std::string> forces = force_names(model);
+  auto listed = [&](const std::vector<SceneItem>& items, const std::string& force, Category c) {
+    for (const auto& it : items)
+      if (it.name == force || (!forces.count(it.name) && it.name == to_string(c))) return true;
+    return false;
+  };
+  auto active = [&](const std::string& force, Category c) {
+    return (!scene->effects || listed(*scene->effects, force, c)) && !listed(scene->without, force, c);
+  };
+
+  // Inputs of interest; the others are zero from now on.
+  std::vector<std::string> inputs;
+  if (scene->inputs) {
+    for (const auto& it : *scene->inputs) inputs.push_back(it.name);
+  } else if (asks(Analysis::frf) || asks(Analysis::statics)) {
+    for (const auto& i : model.inputs()) inputs.push_back(i.name);
+  }
+  GiNaC::exmap dropped;
+  m.inputs_.clear();
+  m.input_symbols_.clear();
+  for (const auto& name_kept : inputs)
+    for (std::size_t i = 0; i < model.inputs().size(); ++i)
+      if (model.inputs()[i].name == name_kept) {
+        m.inputs_.push_back(model.inputs()[i]);
+        m.input_symbols_.push_back(model.input_symbols()[i]);
+      }
+  for (std::size_t i = 0; i < model.inputs().size(); ++i) {
+    const std::string& n = model.inputs()[i].name;
+    if (std::find(inputs.begin(), inputs.end(), n) != inputs.end()) continue;
+    dropped[model.input_symbols()[i]] = 0;
+    m.symtab_.erase(n);
+    m.symbol_names_.erase(n);
+  }
+  auto without_inputs = [&](const ex& e) {
+    return dropped.empty() ? e : e.subs(dropped, GiNaC::subs_options::no_pattern);
+  };
+
+  auto record = [&](const std::string& n, Category c, bool on, const std::string& note = "") {
+    sel.effects.push_back({n, to_string(c), on, note});
+  };
+  auto remove_name = [&](const std::string& n) { m.element_names_.erase(n); };
+
+  m.gravity_.clear();
+  for (const auto& g : model.gravity()) {
+    const bool on = active(g.name, Category::gravity);
+    record(g.name, Category::gravity, on);
+    if (on) m.gravity_.push_back(g); else remove_name(g.name);
+  }
+  m.springs_.clear();
+  for (const auto& s : model.springs()) {
+    const bool on = active(s.name, Category::springs);
+    record(s.name, Category::springs, on);
+    if (on) m.springs_.push_back(s); else remove_name(s.name);
+  }
+  m.dampers_.clear();
+  for (const auto& d : model.dampers()) {
+    const bool on = active(d.name, Category::dampers);
+    record(d.name, Category::dampers, on);
+    if (on) m.dampers_.push_back(d); else remove_name(d.name);
+  }
+  m.bushings_.clear();
+  for (Bushing b : model.bushings()) {
+    const bool has_k = nonzero(b.k_translation) || nonzero(b.k_rotation);
+    const bool has_d = nonzero(b.d_translation) || nonzero(b.d_rotation);
+    const bool k_on = has_k && active(b.name, Category::springs);
+    const bool d_on = has_d && active(b.name, Category::dampers);
+    if (has_k) record(b.name, Category::springs, k_on);
+    if (has_d) record(b.name, Category::dampers, d_on);
+    if (!k_on) b.k_translation = b.k_rotation = zero_vec3();
+    if (!d_on) b.d_translation = b.d_rotation = zero_vec3();
+    if (k_on || d_on) m.bushings_.push_back(b); else remove_name(b.name);
+  }
+  const std::string no_input = "zero without the scene's inputs";
+  m.generalized_forces_.clear();
+  for (GeneralizedForce g : model.generalized_forces()) {
+    bool on = active(g.name, g.category);
+    std::string note;
+    if (on) {
+      g.value = without_inputs(g.value);
+      if (g.value.is_zero()) on = false, note = no_input;
+    }
+    record(g.name, g.category, on, note);
+    if (on) m.generalized_forces_.push_back(g); else remove_name(g.name);
+  }
+  m.applied_forces_.clear();
+  for (AppliedForce a : model.applied_forces()) {
+    bool on = active(a.name, Category::applied);
+    std::string note;
+    if (on) {
+      for (auto* v : {&a.force, &a.torque})
+        for (auto& x : *v) x = without_inputs(x);
+      if (!nonzero(a.force) && !nonzero(a.torque)) on = false, note = no_input;
+    }
+    record(a.name, Category::applied, on, note);
+    if (on) m.applied_forces_.push_back(a); else remove_name(a.name);
+  }
+
+  // Velocity-quadratic inertia terms: their value and first derivatives vanish at ẏ = 0, so
+  // about rest they cannot reach M, Q, K, nor the residual of a static equilibrium.
+  const bool gyroscopic = active("gyroscopic", Category::gyroscopic);
+  m.inertial_velocity_terms_ = gyroscopic && !at_rest;
+  record("gyroscopic", Category::gyroscopic, m.inertial_velocity_terms_,
+         gyroscopic && at_rest ? "cannot contribute at rest (yd0 = 0)" : "");
+  for (const auto& i : model.inputs())
+    sel.effects.push_back({i.name, "inputs", std::find(inputs.begin(), inputs.end(), i.name) != inputs.end(), ""});
+
+  // Outputs of interest.
+  std::vector<std::string> outputs;
+  if (scene->outputs) {
+    for (const auto& it : *scene->outputs) outputs.push_back(it.name);
+  } else if (asks(Analysis::frf)) {
+    for (const auto& o : model.outputs()) outputs.push_back(o.name);
+  }
+  m.outputs_.clear();
+  for (const auto& n : outputs)
+    for (const auto& o : model.outputs())
+      if (o.name == n) m.outputs_.push_back(o);
+  for (const auto& o : model.outputs())
+    if (std::find(outputs.begin(), outputs.end(), o.name) == outputs.end()) remove_name(o.name);
+  return m;
+}
+
+}  // namespace mbsgen
