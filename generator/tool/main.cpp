@@ -2,9 +2,12 @@
 // Exit codes: 0 success, 1 a bad model or failed analysis, 2 a usage error.
 #include "mbsgen/generator/emit.hpp"
 #include "mbsgen/generator/scene.hpp"
+#include "mbsgen/generator/emit_api.hpp"
 #include "mbsgen/generator/yaml_reader.hpp"
 
 #include <CLI/CLI.hpp>
+
+#include "run.hpp"
 
 #include <chrono>
 #include <cstring>
@@ -51,12 +54,59 @@ int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& sce
   return 0;
 }
 
+// mbsgen run MODEL [--scene NAME] [-- ARGS...]
+int run_command(int argc, char** argv) {
+  const char* usage =
+      "usage: mbsgen run MODEL [--scene NAME] -- modes|frf|static|matrices|info [ARGS...]\n"
+      "  generates, compiles and caches the model's solver, then runs it with ARGS\n"
+      "  (the solver's options: mbsgen run MODEL -- --help)\n";
+  std::string model_file, scene = "full";
+  std::vector<std::string> args;
+  int i = 2;
+  for (; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--") {
+      ++i;
+      break;
+    }
+    if (a == "-h" || a == "--help") {
+      std::cout << usage;
+      return 0;
+    }
+    if (a == "--scene" && i + 1 < argc) {
+      scene = argv[++i];
+    } else if (a.rfind("--scene=", 0) == 0) {
+      scene = a.substr(8);
+    } else if (!a.empty() && a[0] != '-' && model_file.empty()) {
+      model_file = a;
+    } else {
+      std::cerr << "mbsgen run: unexpected argument '" << a << "'\n" << usage;
+      return 2;
+    }
+  }
+  for (; i < argc; ++i) args.emplace_back(argv[i]);
+  if (model_file.empty()) {
+    std::cerr << "mbsgen run: missing MODEL\n" << usage;
+    return 2;
+  }
+  try {
+    return mbsgen::tool::run_main(model_file, scene, args);
+  } catch (const mbsgen::ModelError& e) {
+    std::cerr << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "mbsgen run: error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
 #ifdef MBSGEN_HAVE_LINEAR_CLI
   if (argc >= 2 && std::strcmp(argv[1], "linear") == 0) return mbsgen::cli::linear_main(argc - 1, argv + 1);
 #endif
+  if (argc >= 2 && std::strcmp(argv[1], "run") == 0) return run_command(argc, argv);
   CLI::App app{"mbsgen: symbolic-to-numeric code generator for multibody systems"};
   app.require_subcommand(1);
   std::string model_file, out_dir, scene = "full", id;
@@ -74,6 +124,7 @@ int main(int argc, char** argv) {
                                    "MODEL_SCENE for a scene)");
   generate->add_flag("--no-cse", no_cse, "skip common-subexpression elimination");
   app.add_subcommand("linear", "modes and frequency responses of raw matrices (mbsgen linear --help)");
+  app.add_subcommand("run", "generate, compile, cache and run a model's solver (mbsgen run --help)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -98,7 +149,11 @@ int main(int argc, char** argv) {
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (*info) return print_info(pruned, model.scenes(), lin, code, seconds);
     mbsgen::write_generated(code, out_dir);
-    std::cerr << "mbsgen: wrote " << out_dir << "/" << code.id << ".{hpp,cpp,json} in " << seconds
+    const auto& range = pruned.selection().frequency_range;
+    mbsgen::write_api(mbsgen::emit_api(pruned, lin, code, scene, range ? range->from_hz : 0.0,
+                                       range ? range->to_hz : 0.0),
+                      out_dir);
+    std::cerr << "mbsgen: wrote " << out_dir << "/" << code.id << "{.hpp,.cpp,.json,_model.hpp,_model.cpp} in " << seconds
               << " s\n";
     return 0;
   } catch (const mbsgen::ModelError& e) {

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "mbsgen/runtime/error.hpp"
+#include "mbsgen/runtime/frequency_response.hpp"
 
 namespace mbsgen::cli {
 
@@ -62,7 +63,7 @@ void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const E
       const double a = std::abs(g[k]);
       if (!std::isfinite(a) || a <= 0 || !(hz[k] > 0)) continue;  // log axes
       char line[128];
-      std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", hz[k], a, -std::arg(g[k]) * 180.0 / kPi);
+      std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", hz[k], a, phase_lag(g[k]) * 180.0 / kPi);
       d << line;
     }
     if (!d) throw Error("--plot: cannot write " + data.string());
@@ -71,10 +72,11 @@ void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const E
     std::ofstream s(script);
     s << "set terminal " << terminal << "\n"
       << "set output " << quoted(tmp.string()) << "\n"
-      << "set multiplot layout 2,1 title " << quoted(plot.title) << "\n"
+      << "set multiplot layout 2,1 title " << quoted(plot.title) << " noenhanced\n"
+      << "set xrange [" << hz.minCoeff() << ":" << hz.maxCoeff() << "]\n"
       << "set logscale x\nset grid xtics ytics mxtics\nset format x '10^{%L}'\n"
       << "set logscale y\nset format y '10^{%L}'\n"
-      << "set ylabel " << quoted(plot.amplitude_label) << "\n"
+      << "set ylabel " << quoted(plot.amplitude_label) << " noenhanced\n"
       << "unset key\n"
       << "plot " << quoted(data.string()) << " using 1:2 with lines lw 2 lc rgb '#1f4e9c'\n"
       << "unset logscale y\nset format y '%g'\n"

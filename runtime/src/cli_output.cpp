@@ -108,13 +108,13 @@ void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::I
     if (f.shapes) {
       out << "# mode shapes (unit 2-norm, largest entry real positive): amplitude, phase [deg]\n";
       out << pad("coordinate", 16);
-      for (std::size_t j = 0; j < modes.size(); ++j) out << pad("mode " + std::to_string(j + 1), 26);
+      for (std::size_t j = 0; j < modes.size(); ++j) out << pad("mode " + std::to_string(j + 1), 28);
       out << "\n";
       for (Eigen::Index i = 0; i < size; ++i) {
         out << pad(coordinate(i), 16);
         for (const Mode& m : modes) {
           const std::complex<double> x = i < m.shape.size() ? m.shape[i] : 0.0;
-          out << pad(short_num(std::abs(x)), 14) << pad(short_num(std::arg(x) * 180.0 / kPi), 12);
+          out << pad(short_num(std::abs(x)), 14) << pad(short_num(std::arg(x) * 180.0 / kPi), 14);
         }
         out << "\n";
       }

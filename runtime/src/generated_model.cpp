@@ -56,6 +56,17 @@ void GeneratedModel::set(const std::string& name, double value) {
   p_[static_cast<std::size_t>(i)] = value;
 }
 
+void GeneratedModel::set_parameters(const std::vector<double>& values) {
+  if (values.size() != p_.size())
+    throw DimensionError("GeneratedModel::set_parameters: " + std::to_string(values.size()) +
+                         " values for " + std::to_string(p_.size()) + " parameters of model '" +
+                         k_.model + "'");
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i]))
+      throw NonFiniteError("parameter '" + parameter_names_[i] + "' set to a non-finite value");
+  p_ = values;
+}
+
 void GeneratedModel::set(const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0 || eq + 1 == assignment.size())

@@ -150,8 +150,8 @@ int run_static(const ModelKernels& k, const Options& o, std::ostream& out) {
     out << pad(names[i], 16) << pad(num(op.y0[static_cast<Eigen::Index>(i)], false), 26)
         << pad(num(op.yd0[static_cast<Eigen::Index>(i)], false), 26) << "  "
         << unit_or(k.coordinate_units, static_cast<Eigen::Index>(i), "-") << "\n";
-  out << "# " << (op.equilibrium ? "static equilibrium: " : "operating point ") << op.report
-      << ", residual norm " << short_num(op.residual_norm) << ", iterations " << op.iterations << "\n";
+  out << "# " << (op.equilibrium ? "static equilibrium, " : "operating point given by the model, ")
+      << "residual norm " << short_num(op.residual_norm) << ", Newton iterations " << op.iterations << "\n";
   return 0;
 }
 

@@ -28,8 +28,11 @@ std::vector<Example> read_examples(const std::string& path) {
   bool in_console = false;
   int lineno = 0;
   bool expect_code = false;
+  bool in_section = false;  // "## `mbsgen linear`"; other sections have their own tests
   while (std::getline(in, line)) {
     ++lineno;
+    if (line.rfind("## ", 0) == 0) in_section = line == "## `mbsgen linear`";
+    if (!in_section) continue;
     if (line.rfind("```", 0) == 0) {
       in_console = line == "```console";
       continue;

@@ -75,6 +75,9 @@ class GeneratedModel {
   /// Sets a parameter by name; NameError for an unknown name (listing the known ones),
   /// NonFiniteError for a NaN or infinite value.
   void set(const std::string& name, double value);
+  /// Sets all parameters, in the kernels' order; DimensionError for a wrong count,
+  /// NonFiniteError for a NaN or infinite value (naming the parameter).
+  void set_parameters(const std::vector<double>& values);
   /// Parses "NAME=VALUE" (as `--set` gives it) and calls set(); NameError when malformed.
   void set(const std::string& assignment);
 

@@ -1,0 +1,196 @@
+// Model solvers (issue 4): the typed API of a generated model against the closed form, the
+// solver's exit codes, and every example of docs/cli.md "Model solvers", run as documented.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "double_pendulum_model.hpp"
+#include "mbsgen/runtime/solver_cli.hpp"
+
+namespace {
+
+// Double pendulum, point masses, absolute angles (closed-forms.md §2):
+// M = [[(m1+m2) l1², m2 l1 l2], [m2 l1 l2, m2 l2²]], K = diag((m1+m2) g l1, m2 g l2), Q = 0.
+TEST(TypedApi, DoublePendulumMatchesClosedForm) {
+  double_pendulum::Parameters p;
+  EXPECT_EQ(p.g, 9.81);  // the model file's default
+  p.m1 = 2.0;
+  p.l2 = 0.5;
+  const mbsgen::LinearModel lin = double_pendulum::linear_model(p);
+  ASSERT_EQ(lin.size(), 2);
+  const double M[2][2] = {{(p.m1 + p.m2) * p.l1 * p.l1, p.m2 * p.l1 * p.l2}, {p.m2 * p.l1 * p.l2, p.m2 * p.l2 * p.l2}};
+  const double K[2][2] = {{(p.m1 + p.m2) * p.g * p.l1, 0}, {0, p.m2 * p.g * p.l2}};
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) {
+      // The kernels evaluate a few products and sums of the same numbers: a few ulps.
+      EXPECT_NEAR(lin.M()(i, j), M[i][j], 4e-16 * 10) << i << "," << j;
+      EXPECT_NEAR(lin.K()(i, j), K[i][j], 4e-15 * 10) << i << "," << j;
+      EXPECT_EQ(lin.Q()(i, j), 0.0);
+    }
+  EXPECT_EQ(lin.coordinate_names()[static_cast<int>(double_pendulum::Coordinate::phi2)], "phi2");
+  EXPECT_EQ(lin.input_names()[static_cast<int>(double_pendulum::Input::F)], "F");
+  EXPECT_EQ(lin.coordinate_units()[0], "rad");
+}
+
+TEST(GeneratedModel, SetByNameAndErrors) {
+  mbsgen::GeneratedModel m(double_pendulum::kernels());
+  m.set("g=1.62");
+  EXPECT_DOUBLE_EQ(m.linear_model().K()(1, 1), 1.0 * 1.62 * 1.0);  // m2 g l2
+  EXPECT_THROW(m.set("G=1"), mbsgen::NameError);
+  EXPECT_THROW(m.set("g="), mbsgen::NameError);
+  EXPECT_THROW(m.set("g=1.5x"), mbsgen::NameError);
+  EXPECT_THROW(m.set("g", std::nan("")), mbsgen::NonFiniteError);
+  try {
+    m.set("lenght=1");
+    FAIL();
+  } catch (const mbsgen::NameError& e) {
+    EXPECT_NE(std::string(e.what()).find("known: m1, m2, l1, l2, g"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(m.output_index("nope"), mbsgen::NameError);
+}
+
+int solve(std::vector<std::string> args, std::string* out_text = nullptr, std::string* err_text = nullptr) {
+  args.insert(args.begin(), "double_pendulum-solve");
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  std::ostringstream out, err;
+  const int rc = mbsgen::cli::solver_main(double_pendulum::kernels(), static_cast<int>(argv.size()),
+                                          argv.data(), out, err);
+  if (out_text) *out_text = out.str();
+  if (err_text) *err_text = err.str();
+  return rc;
+}
+
+TEST(SolverCli, ExitCodes) {
+  std::string out, err;
+  EXPECT_EQ(solve({"modes"}, &out), 0);
+  EXPECT_NE(out.find("finite"), std::string::npos);
+  EXPECT_EQ(solve({}), 2);                                         // no subcommand
+  EXPECT_EQ(solve({"modes", "--set", "nope=1"}, nullptr, &err), 2);  // unknown parameter
+  EXPECT_NE(err.find("unknown parameter 'nope'"), std::string::npos) << err;
+  EXPECT_NE(err.find("known: m1, m2, l1, l2, g"), std::string::npos) << err;
+  EXPECT_EQ(solve({"modes", "--set", "g=abc"}), 2);                // malformed number
+  EXPECT_EQ(solve({"modes", "--set", "g=nan"}), 1);                // non-finite: a model error
+  EXPECT_EQ(solve({"frf", "--input", "X", "--output", "x2"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("unknown input 'X'"), std::string::npos) << err;
+  EXPECT_EQ(solve({"frf", "--input", "F", "--output", "x2", "--from", "10", "--to", "1"}), 2);
+  EXPECT_EQ(solve({"frf", "--input", "F", "--output", "x2", "--points", "0"}), 2);
+  EXPECT_EQ(solve({"frf", "--input", "F"}), 2);                    // --output missing
+  EXPECT_EQ(solve({"frf", "--input", "F", "--output", "tip_x", "--plot", "/tmp/x.txt"}), 1);  // not .svg/.png
+  EXPECT_EQ(solve({"modes", "--help"}, &out), 0);
+  EXPECT_NE(out.find("--shapes"), std::string::npos);
+}
+
+// ---- docs/cli.md "Model solvers": every example, run in the source directory ----
+
+struct Example {
+  std::string command;
+  std::vector<std::string> output;
+  int exit_code = 0;
+  int line = 0;
+};
+
+std::vector<Example> read_examples(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<Example> out;
+  std::string line;
+  bool in_section = false, in_console = false, expect_code = false;
+  int lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (line.rfind("## ", 0) == 0) in_section = line == "## Model solvers";
+    if (!in_section) continue;
+    if (line.rfind("```", 0) == 0) {
+      in_console = line == "```console";
+      continue;
+    }
+    if (!in_console) continue;
+    if (line == "$ echo $?") {
+      expect_code = true;
+    } else if (expect_code) {
+      out.back().exit_code = std::stoi(line);
+      expect_code = false;
+    } else if (line.rfind("$ ", 0) == 0) {
+      out.push_back({line.substr(2), {}, 0, lineno});
+    } else if (!out.empty()) {
+      out.back().output.push_back(line);
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> tokens(const std::string& s) {
+  std::vector<std::string> t;
+  std::string cur;
+  for (char c : s) {
+    if (std::string(" ,:{}[]\"\t").find(c) != std::string::npos) {
+      if (!cur.empty()) t.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  if (!cur.empty()) t.push_back(cur);
+  return t;
+}
+
+/// Numbers equal to 6 significant digits (the table precision; LAPACK differs between machines
+/// in the last digits), values below 1e-12 in magnitude (rounding-level) equal to each other,
+/// other tokens exactly.
+bool same_token(const std::string& a, const std::string& b) {
+  if (a == b) return true;
+  char* ea = nullptr;
+  char* eb = nullptr;
+  const double x = std::strtod(a.c_str(), &ea), y = std::strtod(b.c_str(), &eb);
+  if (*ea != '\0' || *eb != '\0' || ea == a.c_str() || eb == b.c_str()) return false;
+  if (std::abs(x) < 1e-12 && std::abs(y) < 1e-12) return true;
+  return std::abs(x - y) <= 5e-6 * std::max(std::abs(x), std::abs(y));
+}
+
+TEST(SolverCli, DocumentationExamples) {
+  const auto examples = read_examples(std::string(MBSGEN_SOURCE_DIR) + "/docs/cli.md");
+  ASSERT_GE(examples.size(), 6u) << "docs/cli.md \"Model solvers\" examples not found";
+  const std::string tmp = std::string(MBSGEN_TEST_CACHE) + "/out";
+  std::filesystem::create_directories(tmp);
+  for (const Example& ex : examples) {
+    SCOPED_TRACE("docs/cli.md:" + std::to_string(ex.line) + ": " + ex.command);
+    const std::string cmd = std::string("cd '") + MBSGEN_SOURCE_DIR + "' && PATH='" +
+                            MBSGEN_GENERATED_BIN_DIR + ":" + MBSGEN_TOOL_DIR + ":'\"$PATH\" MBSGEN_CACHE_DIR='" +
+                            MBSGEN_TEST_CACHE + "' TMPDIR='" + tmp + "' sh -c '" + ex.command +
+                            "' 2>&1; echo \"__exit $?\"";
+    FILE* p = popen(cmd.c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    std::string all;
+    std::array<char, 4096> buf{};
+    while (std::fgets(buf.data(), buf.size(), p)) all += buf.data();
+    pclose(p);
+    std::vector<std::string> lines;
+    std::istringstream ss(all);
+    std::string l;
+    int code = -1;
+    while (std::getline(ss, l)) {
+      if (l.rfind("__exit ", 0) == 0)
+        code = std::stoi(l.substr(7));
+      else
+        lines.push_back(l);
+    }
+    EXPECT_EQ(code, ex.exit_code) << all;
+    ASSERT_EQ(lines.size(), ex.output.size()) << all;
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      const auto a = tokens(lines[i]), b = tokens(ex.output[i]);
+      bool same = a.size() == b.size();
+      for (std::size_t k = 0; same && k < a.size(); ++k) same = same_token(a[k], b[k]);
+      EXPECT_TRUE(same) << "got:      " << lines[i] << "\nexpected: " << ex.output[i];
+    }
+  }
+}
+
+}  // namespace
