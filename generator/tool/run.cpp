@@ -6,6 +6,7 @@
 
 #include "mbsgen/generator/emit.hpp"
 #include "mbsgen/generator/emit_api.hpp"
+#include "mbsgen/generator/scene.hpp"
 #include "mbsgen/generator/yaml_reader.hpp"
 #include "mbsgen_build_config.hpp"
 
@@ -101,9 +102,8 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
     const bool terminal = ::isatty(STDERR_FILENO);
     if (terminal) std::cerr << "mbsgen run: generating and compiling the solver of " << model_file << " …" << std::flush;
     const auto t0 = std::chrono::steady_clock::now();
-    Model model = read_model_file(model_file);
-    if (scene != "full")
-      throw std::runtime_error("model '" + model.name() + "' has no scene '" + scene + "' (scenes: full)");
+    const Model full = read_model_file(model_file);
+    const Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
     Equations eq = derive(model);
     LinearEquations lin = linearize(eq);
     EmitOptions options;
@@ -111,7 +111,8 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
     options.source_file = model_file;
     options.id = "model";
     GeneratedCode code = emit(model, eq, lin, options);
-    GeneratedApi api = emit_api(model, lin, code, scene);
+    const auto& range = model.selection().frequency_range;
+    GeneratedApi api = emit_api(model, lin, code, scene, range ? range->from_hz : 0.0, range ? range->to_hz : 0.0);
     // Build in a private directory, then rename: a concurrent or interrupted run never leaves
     // a half-built solver in the cache.
     fs::create_directories(dir.parent_path());
