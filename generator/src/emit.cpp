@@ -514,7 +514,10 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   for (std::size_t i = 0; i < nb; ++i) j << (i ? ", " : "") << json_string(model.bodies()[i].name);
   j << "],\n  \"operating_point\": {\"kind\": "
     << (lin.equilibrium ? "\"equilibrium\"" : "\"given\"") << ", \"at_rest\": "
-    << (lin.at_rest ? "true" : "false") << "},\n  \"effects\": [";
+    << (lin.at_rest ? "true" : "false") << ", \"zero_rates\": [";
+  for (std::size_t i = 0; i < lin.zero_rates.size(); ++i)
+    j << (i ? ", " : "") << json_string(model.coordinates()[lin.zero_rates[i]].name);
+  j << "]},\n  \"effects\": [";
   for (std::size_t i = 0; i < scene.effects.size(); ++i) {
     const EffectState& e = scene.effects[i];
     j << (i ? "," : "") << "\n    {\"name\": " << json_string(e.name) << ", \"category\": "

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <unordered_map>
 
 namespace mbsgen {
 
@@ -10,12 +11,15 @@ using GiNaC::ex;
 namespace {
 
 // Values of program expressions at one point of the variables, in floating point of kDigits
-// decimal digits. Reads the program's definitions only (defines nothing).
+// decimal digits (CLN). Reads the program's definitions only (defines nothing).
 class PointEvaluator {
  public:
   static constexpr long kDigits = 50;
 
-  PointEvaluator(const Program& program, GiNaC::exmap point) : prog_(program), values_(std::move(point)) {}
+  /// point: a value for every variable that the expressions use.
+  PointEvaluator(const Program& program, const GiNaC::exmap& point) : prog_(program) {
+    for (const auto& [x, v] : point) values_.emplace(x, float_of(v));
+  }
 
   std::vector<GiNaC::numeric> evaluate(const std::vector<ex>& entries) {
     const auto& defs = prog_.definitions();
@@ -36,7 +40,7 @@ class PointEvaluator {
     }
     // A definition refers to earlier ones only.
     for (std::size_t i = 0; i < defs.size(); ++i)
-      if (needed[i]) values_[defs[i].symbol] = number(defs[i].value);
+      if (needed[i]) values_.emplace(defs[i].symbol, number(defs[i].value));
     std::vector<GiNaC::numeric> out;
     out.reserve(entries.size());
     for (const ex& e : entries) out.push_back(number(e));
@@ -44,13 +48,45 @@ class PointEvaluator {
   }
 
  private:
-  GiNaC::numeric number(const ex& e) const {
-    const ex v = GiNaC::evalf(e.subs(values_, GiNaC::subs_options::no_pattern));
+  static GiNaC::numeric float_of(const ex& e) {
+    const ex v = GiNaC::evalf(e);
     if (!GiNaC::is_a<GiNaC::numeric>(v)) throw std::runtime_error("not a number");
     return GiNaC::ex_to<GiNaC::numeric>(v);
   }
+
+  GiNaC::numeric number(const ex& e) const {
+    using GiNaC::is_a;
+    if (is_a<GiNaC::numeric>(e)) return GiNaC::ex_to<GiNaC::numeric>(e);
+    if (is_a<GiNaC::symbol>(e)) {
+      auto it = values_.find(e);
+      if (it == values_.end()) throw std::runtime_error("unbound symbol");
+      return it->second;
+    }
+    if (is_a<GiNaC::add>(e)) {
+      GiNaC::numeric sum = 0;
+      for (std::size_t i = 0; i < e.nops(); ++i) sum += number(e.op(i));
+      return sum;
+    }
+    if (is_a<GiNaC::mul>(e)) {
+      GiNaC::numeric product = 1;
+      for (std::size_t i = 0; i < e.nops(); ++i) product *= number(e.op(i));
+      return product;
+    }
+    if (is_a<GiNaC::power>(e)) {
+      const GiNaC::numeric base = number(e.op(0)), exponent = number(e.op(1));
+      if (exponent.is_integer()) return base.power(exponent);
+      return GiNaC::ex_to<GiNaC::numeric>(base.evalf()).power(exponent);
+    }
+    if (is_a<GiNaC::function>(e)) {
+      GiNaC::exvector args;
+      for (std::size_t i = 0; i < e.nops(); ++i) args.push_back(number(e.op(i)));
+      return float_of(GiNaC::function(GiNaC::ex_to<GiNaC::function>(e).get_serial(), args));
+    }
+    return float_of(e);  // constants such as Pi
+  }
+
   const Program& prog_;
-  GiNaC::exmap values_;
+  std::unordered_map<ex, GiNaC::numeric, std::hash<ex>, GiNaC::ex_is_equal> values_;
 };
 
 struct Structure {
@@ -136,11 +172,16 @@ LinearEquations linearize(Equations& eq) {
   }
 
   // The operating point has u = 0 and, at rest, ẏ = 0: substituted through the program so that
-  // every term that vanishes there (gyroscopic, centrifugal, damping forces) drops out.
+  // every term that vanishes there (gyroscopic, centrifugal, damping forces) drops out. A scene
+  // (apply_scene) also fixes the rates its steady motion sets to zero (a spinning rotor's tilt
+  // rates), so that only the nonzero rates remain arguments of the kernels.
   GiNaC::exmap at_op;
   for (const auto& s : eq.u) at_op[s] = 0;
-  if (lin.at_rest)
-    for (const auto& s : eq.yd) at_op[s] = 0;
+  for (std::size_t k = 0; k < f; ++k)
+    if (lin.at_rest || (!model.selection().full && lin.yd0[k].is_zero())) {
+      at_op[eq.yd[k]] = 0;
+      lin.zero_rates.push_back(k);
+    }
   Program::Substitution sub(at_op);
   auto at = [&](const ex& e) { return prog.substitute(e, sub); };
 

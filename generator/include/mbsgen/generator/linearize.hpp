@@ -13,6 +13,10 @@ struct LinearEquations {
   /// True when every steady velocity of the operating point is zero: ẏ0 = 0 is then
   /// substituted before differentiation and the kernels take no ẏ0.
   bool at_rest = true;
+  /// Coordinates whose rate ẏ0 is fixed at zero before differentiation: all of them at rest,
+  /// and in a scene every rate its operating point sets to zero; the kernels ignore these
+  /// components of ẏ0.
+  std::vector<std::size_t> zero_rates;
   ExMatrix M, Q, K, B, Cy, Cv;  ///< f×f, f×f, f×f, f×m, r×f, r×f (expressions in y, ẏ, p)
   ExMatrix D, G, Ks, N;         ///< sym Q, skew Q, sym K, skew K
   std::vector<GiNaC::ex> y0, yd0;  ///< default operating point (expressions in p)
