@@ -1,6 +1,6 @@
 // The generated linear kernel of the middle-ear model against an independent, finite-element
 // style assembly of the same 18-coordinate system, written here from the reference notes
-// (/work/shared/reference/middle-ear.md, "Proposed parameter set") and not from the generator's
+// (../shared/reference/middle-ear.md, "Proposed parameter set") and not from the generator's
 // route (frames, rotation matrices, Newton-Euler projection, symbolic differentiation).
 //
 // Small-displacement field: body b (0 malleus, 1 incus, 2 stapes) has the coordinates
