@@ -26,18 +26,18 @@ std::string identifier(const std::string& name) {
   return id;
 }
 
-namespace {
-
-std::string upper(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return s;
-}
-
 std::string format_double(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.17g", v);
   std::string s = buf;
   if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+namespace {
+
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return s;
 }
 
@@ -537,8 +537,6 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   return out;
 }
 
-namespace {
-
 void write_atomically(const std::filesystem::path& path, const std::string& content) {
   {
     std::ifstream in(path, std::ios::binary);
@@ -559,8 +557,6 @@ void write_atomically(const std::filesystem::path& path, const std::string& cont
   }
   std::filesystem::rename(tmp, path);
 }
-
-}  // namespace
 
 void write_generated(const GeneratedCode& code, const std::string& dir) {
   std::filesystem::create_directories(dir);

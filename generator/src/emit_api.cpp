@@ -2,7 +2,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -26,14 +25,6 @@ std::string literal(const std::string& s) {
     }
   }
   return o + "\"";
-}
-
-std::string number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  std::string s = buf;
-  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
-  return s;
 }
 
 bool keyword(const std::string& s) {
@@ -73,26 +64,6 @@ bool has_kernel(const GeneratedCode& code, const std::string& name) {
   return false;
 }
 
-void write_atomically(const std::filesystem::path& path, const std::string& content) {
-  {
-    std::ifstream in(path, std::ios::binary);
-    if (in) {
-      std::ostringstream old;
-      old << in.rdbuf();
-      if (old.str() == content) return;
-    }
-  }
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
-  {
-    std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
-    o << content;
-    o.close();
-    if (!o) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  std::filesystem::rename(tmp, path);
-}
-
 }  // namespace
 
 GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const GeneratedCode& code,
@@ -116,7 +87,7 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
   h << "/// The model's parameters (SI units), initialised with its defaults.\nstruct Parameters {\n";
   for (std::size_t i = 0; i < pm.size(); ++i) {
     const auto& p = model.parameters()[i];
-    h << "  double " << pm[i] << " = " << number(p.value) << ";";
+    h << "  double " << pm[i] << " = " << format_double(p.value) << ";";
     std::string doc = p.unit;
     if (!p.source.empty()) doc += (doc.empty() ? "" : "; ") + p.source;
     if (!doc.empty()) {
@@ -164,7 +135,7 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
   for (const auto& c : model.coordinates()) cu.push_back(c.unit);
   for (const auto& p : model.parameters()) {
     pu.push_back(p.unit);
-    defaults.push_back(number(p.value));
+    defaults.push_back(format_double(p.value));
   }
   for (const auto& i : model.inputs()) iu.push_back(i.unit);
   for (const auto& o : model.outputs()) ou.push_back(o.unit);
@@ -186,7 +157,7 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     << "      " << literal(id) << ", " << literal(model.name()) << ", " << literal(scene) << ", " << id
     << "_abi_version(),\n      " << cn.size() << ", " << in.size() << ", " << on.size() << ", "
     << pn.size() << ", " << (lin.at_rest ? "true" : "false") << ", "
-    << (lin.equilibrium ? "true" : "false") << ", " << number(from_hz) << ", " << number(to_hz)
+    << (lin.equilibrium ? "true" : "false") << ", " << format_double(from_hz) << ", " << format_double(to_hz)
     << ",\n      " << id << "_coordinate_names, coordinate_units, " << id << "_parameter_names, parameter_units, "
     << id << "_parameter_defaults,\n      " << id << "_input_names, input_units, " << id
     << "_output_names, output_units,\n      " << kernel("operating_point") << ", " << kernel("linear")

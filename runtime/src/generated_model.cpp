@@ -10,12 +10,6 @@ namespace mbsgen {
 
 namespace {
 
-std::vector<std::string> names(const char* const* list, int n) {
-  std::vector<std::string> v;
-  for (int i = 0; i < n; ++i) v.emplace_back(list && list[i] ? list[i] : "");
-  return v;
-}
-
 std::string join(const std::vector<std::string>& v) {
   std::string s;
   for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
@@ -37,6 +31,12 @@ void check_status(int status, const char* kernel, const std::string& model) {
 
 }  // namespace
 
+std::vector<std::string> name_list(const char* const* list, int n) {
+  std::vector<std::string> v;
+  for (int i = 0; i < n; ++i) v.emplace_back(list && list[i] ? list[i] : "");
+  return v;
+}
+
 GeneratedModel::GeneratedModel(const ModelKernels& kernels) : k_(kernels) {
   if (k_.abi_version != kKernelAbiVersion)
     throw Error("GeneratedModel: model '" + std::string(k_.id) + "' has kernel ABI version " +
@@ -45,7 +45,7 @@ GeneratedModel::GeneratedModel(const ModelKernels& kernels) : k_(kernels) {
   if (!k_.operating_point || !k_.linear)
     throw Error("GeneratedModel: model '" + std::string(k_.id) +
                 "' lacks the operating_point or linear kernel (its scene asks for no linear analysis)");
-  parameter_names_ = names(k_.parameter_names, k_.n_parameters);
+  parameter_names_ = name_list(k_.parameter_names, k_.n_parameters);
   p_.assign(k_.parameter_defaults, k_.parameter_defaults + k_.n_parameters);
 }
 
@@ -81,11 +81,11 @@ void GeneratedModel::set(const std::string& assignment) {
 }
 
 Eigen::Index GeneratedModel::input_index(const std::string& name) const {
-  return find(names(k_.input_names, k_.n_inputs), name, "input", k_.model);
+  return find(name_list(k_.input_names, k_.n_inputs), name, "input", k_.model);
 }
 
 Eigen::Index GeneratedModel::output_index(const std::string& name) const {
-  return find(names(k_.output_names, k_.n_outputs), name, "output", k_.model);
+  return find(name_list(k_.output_names, k_.n_outputs), name, "output", k_.model);
 }
 
 Eigen::VectorXd GeneratedModel::residual(const Eigen::VectorXd& y, const Eigen::VectorXd& yd) const {
@@ -148,10 +148,10 @@ LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
                          ptr(Cy), ptr(Cv)),
                "linear", k_.model);
   return LinearModel(std::move(M), std::move(Q), std::move(K), std::move(B), std::move(Cy),
-                     std::move(Cv), names(k_.coordinate_names, k_.n_coordinates),
-                     names(k_.input_names, k_.n_inputs), names(k_.output_names, k_.n_outputs),
-                     names(k_.coordinate_units, k_.n_coordinates),
-                     names(k_.input_units, k_.n_inputs), names(k_.output_units, k_.n_outputs));
+                     std::move(Cv), name_list(k_.coordinate_names, k_.n_coordinates),
+                     name_list(k_.input_names, k_.n_inputs), name_list(k_.output_names, k_.n_outputs),
+                     name_list(k_.coordinate_units, k_.n_coordinates),
+                     name_list(k_.input_units, k_.n_inputs), name_list(k_.output_units, k_.n_outputs));
 }
 
 }  // namespace mbsgen

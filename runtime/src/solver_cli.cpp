@@ -22,12 +22,6 @@ namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 
-std::vector<std::string> list(const char* const* names, int n) {
-  std::vector<std::string> v;
-  for (int i = 0; i < n; ++i) v.emplace_back(names && names[i] ? names[i] : "");
-  return v;
-}
-
 std::string unit_or(const char* const* units, Eigen::Index i, const char* fallback) {
   if (!units || !units[i] || !*units[i]) return fallback;
   return units[i];
@@ -132,7 +126,7 @@ int run_frf(const ModelKernels& k, const Options& o, std::ostream& out, std::ost
 int run_static(const ModelKernels& k, const Options& o, std::ostream& out) {
   GeneratedModel model = configured(k, o);
   const OperatingPoint op = model.operating_point();
-  const auto names = list(k.coordinate_names, k.n_coordinates);
+  const auto names = name_list(k.coordinate_names, k.n_coordinates);
   if (o.format == "json") {
     out << "{\"equilibrium\":" << (op.equilibrium ? "true" : "false")
         << ",\"iterations\":" << op.iterations << ",\"residual_norm\":" << num(op.residual_norm, true)
@@ -174,12 +168,12 @@ void json_names(std::ostream& out, const std::vector<std::string>& v) {
 int run_matrices(const ModelKernels& k, const Options& o, std::ostream& out, std::ostream& err) {
   GeneratedModel model = configured(k, o);
   const LinearModel lin = model.linear_model();
+  const std::pair<const char*, const Eigen::MatrixXd*> mats[] = {
+      {"M", &lin.M()}, {"Q", &lin.Q()}, {"K", &lin.K()}, {"B", &lin.B()}, {"C_y", &lin.C_y()}, {"C_v", &lin.C_v()}};
   if (o.format == "mtx") {
     namespace fs = std::filesystem;
     const fs::path dir = o.out_dir.empty() ? fs::path(".") : fs::path(o.out_dir);
     fs::create_directories(dir);
-    const std::pair<const char*, const Eigen::MatrixXd*> mats[] = {
-        {"M", &lin.M()}, {"Q", &lin.Q()}, {"K", &lin.K()}, {"B", &lin.B()}, {"C_y", &lin.C_y()}, {"C_v", &lin.C_v()}};
     for (const auto& [name, A] : mats) {
       const fs::path target = dir / (std::string(name) + ".mtx");
       const fs::path tmp = dir / ("." + std::string(name) + ".mtx.tmp");
@@ -195,8 +189,6 @@ int run_matrices(const ModelKernels& k, const Options& o, std::ostream& out, std
   json_names(out, lin.input_names());
   out << ",\n\"outputs\":";
   json_names(out, lin.output_names());
-  const std::pair<const char*, const Eigen::MatrixXd*> mats[] = {
-      {"M", &lin.M()}, {"Q", &lin.Q()}, {"K", &lin.K()}, {"B", &lin.B()}, {"C_y", &lin.C_y()}, {"C_v", &lin.C_v()}};
   for (const auto& [name, A] : mats) {
     out << ",\n\"" << name << "\":";
     json_matrix(out, *A);

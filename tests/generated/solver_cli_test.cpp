@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "../common/doc_examples.hpp"
 #include "double_pendulum_model.hpp"
 #include "mbsgen/runtime/solver_cli.hpp"
 
@@ -89,107 +90,19 @@ TEST(SolverCli, ExitCodes) {
   EXPECT_NE(out.find("--shapes"), std::string::npos);
 }
 
-// ---- docs/cli.md "Model solvers": every example, run in the source directory ----
-
-struct Example {
-  std::string command;
-  std::vector<std::string> output;
-  int exit_code = 0;
-  int line = 0;
-};
-
-std::vector<Example> read_examples(const std::string& path) {
-  std::ifstream in(path);
-  std::vector<Example> out;
-  std::string line;
-  bool in_section = false, in_console = false, expect_code = false;
-  int lineno = 0;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (line.rfind("## ", 0) == 0) in_section = line == "## Model solvers";
-    if (!in_section) continue;
-    if (line.rfind("```", 0) == 0) {
-      in_console = line == "```console";
-      continue;
-    }
-    if (!in_console) continue;
-    if (line == "$ echo $?") {
-      expect_code = true;
-    } else if (expect_code) {
-      out.back().exit_code = std::stoi(line);
-      expect_code = false;
-    } else if (line.rfind("$ ", 0) == 0) {
-      out.push_back({line.substr(2), {}, 0, lineno});
-    } else if (!out.empty()) {
-      out.back().output.push_back(line);
-    }
-  }
-  return out;
-}
-
-std::vector<std::string> tokens(const std::string& s) {
-  std::vector<std::string> t;
-  std::string cur;
-  for (char c : s) {
-    if (std::string(" ,:{}[]\"\t").find(c) != std::string::npos) {
-      if (!cur.empty()) t.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
-  }
-  if (!cur.empty()) t.push_back(cur);
-  return t;
-}
-
-/// Numbers equal to 6 significant digits (the table precision; LAPACK differs between machines
-/// in the last digits), values below 1e-12 in magnitude (rounding-level) equal to each other,
-/// other tokens exactly.
-bool same_token(const std::string& a, const std::string& b) {
-  if (a == b) return true;
-  char* ea = nullptr;
-  char* eb = nullptr;
-  const double x = std::strtod(a.c_str(), &ea), y = std::strtod(b.c_str(), &eb);
-  if (*ea != '\0' || *eb != '\0' || ea == a.c_str() || eb == b.c_str()) return false;
-  if (std::abs(x) < 1e-12 && std::abs(y) < 1e-12) return true;
-  return std::abs(x - y) <= 5e-6 * std::max(std::abs(x), std::abs(y));
-}
-
+// Every example of docs/cli.md "Model solvers", run in the source directory with the build's
+// solvers and mbsgen on the PATH and a private solver cache.
 TEST(SolverCli, DocumentationExamples) {
-  const auto examples = read_examples(std::string(MBSGEN_SOURCE_DIR) + "/docs/cli.md");
+  const auto examples = doc_examples::read(std::string(MBSGEN_SOURCE_DIR) + "/docs/cli.md", "## Model solvers");
   ASSERT_GE(examples.size(), 6u) << "docs/cli.md \"Model solvers\" examples not found";
   const std::string tmp = std::string(MBSGEN_TEST_CACHE) + "/out";
   std::filesystem::create_directories(tmp);
-  for (const Example& ex : examples) {
+  for (const auto& ex : examples) {
     SCOPED_TRACE("docs/cli.md:" + std::to_string(ex.line) + ": " + ex.command);
-    const std::string cmd = std::string("cd '") + MBSGEN_SOURCE_DIR + "' && PATH='" +
-                            MBSGEN_GENERATED_BIN_DIR + ":" + MBSGEN_TOOL_DIR + ":'\"$PATH\" MBSGEN_CACHE_DIR='" +
-                            MBSGEN_TEST_CACHE + "' TMPDIR='" + tmp + "' sh -c '" + ex.command +
-                            "' 2>&1; echo \"__exit $?\"";
-    FILE* p = popen(cmd.c_str(), "r");
-    ASSERT_NE(p, nullptr);
-    std::string all;
-    std::array<char, 4096> buf{};
-    while (std::fgets(buf.data(), buf.size(), p)) all += buf.data();
-    pclose(p);
-    std::vector<std::string> lines;
-    std::istringstream ss(all);
-    std::string l;
-    int code = -1;
-    while (std::getline(ss, l)) {
-      if (l.rfind("__exit ", 0) == 0)
-        code = std::stoi(l.substr(7));
-      else
-        lines.push_back(l);
-    }
-    EXPECT_EQ(code, ex.exit_code) << all;
-    ASSERT_EQ(lines.size(), ex.output.size()) << all;
-    for (std::size_t i = 0; i < lines.size(); ++i) {
-      const auto a = tokens(lines[i]), b = tokens(ex.output[i]);
-      bool same = a.size() == b.size();
-      for (std::size_t k = 0; same && k < a.size(); ++k) same = same_token(a[k], b[k]);
-      EXPECT_TRUE(same) << "got:      " << lines[i] << "\nexpected: " << ex.output[i];
-    }
+    doc_examples::expect_output(std::string("cd '") + MBSGEN_SOURCE_DIR + "' && PATH='" + MBSGEN_GENERATED_BIN_DIR +
+                                    ":" + MBSGEN_TOOL_DIR + ":'\"$PATH\" MBSGEN_CACHE_DIR='" + MBSGEN_TEST_CACHE +
+                                    "' TMPDIR='" + tmp + "' sh -c '" + ex.command + "'",
+                                ex);
   }
 }
 

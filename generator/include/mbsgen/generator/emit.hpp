@@ -8,6 +8,7 @@
 #include "mbsgen/generator/linearize.hpp"
 #include "mbsgen/generator/scene.hpp"
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,13 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
 /// (a temporary file, then rename). Files whose content is unchanged are not touched, so a
 /// build system does not recompile them.
 void write_generated(const GeneratedCode& code, const std::string& dir);
+
+/// Writes content to path atomically (a temporary file, then rename); leaves the file untouched
+/// when its content is already that.
+void write_atomically(const std::filesystem::path& path, const std::string& content);
+
+/// A double as a C++ literal that round-trips (%.17g, with ".0" added to integers).
+std::string format_double(double v);
 
 /// A C identifier made from a model name.
 std::string identifier(const std::string& name);

@@ -46,6 +46,9 @@ struct ModelKernels {
   int (*mass_matrix)(const double* y, const double* p, double* M);
 };
 
+/// The first n entries of a kernel name array (null entries become "").
+std::vector<std::string> name_list(const char* const* names, int n);
+
 /// A bad name or value from the user (unknown parameter, input or output; malformed value).
 /// The message names what is wrong and lists what exists.
 class NameError : public Error {
