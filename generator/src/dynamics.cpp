@@ -1,5 +1,8 @@
 #include "mbsgen/generator/dynamics.hpp"
 
+#include <algorithm>
+#include <utility>
+
 namespace mbsgen {
 
 using GiNaC::ex;
@@ -12,7 +15,7 @@ Spatial wrench_at_origin(const Vec3& point, const Vec3& force, const Vec3& torqu
 
 }  // namespace
 
-Equations derive(const Model& model) {
+Equations derive(const Model& model, const DeriveOptions& options) {
   model.validate();
   Equations eq;
   eq.model = &model;
@@ -57,49 +60,80 @@ Equations derive(const Model& model) {
   }
   for (std::size_t i = 0; i < nb; ++i) wrench[i] = define(prog, wrench[i]);
 
-  // Backward pass: composite wrenches and composite inertias.
-  std::vector<Spatial> Fc = wrench;
-  std::vector<SpatialInertia> Ic(nb);
-  for (std::size_t i = 0; i < nb; ++i) Ic[i] = kin.bodies[i].inertia;
-  for (std::size_t i = nb; i-- > 0;) {
-    Fc[i] = define(prog, Fc[i]);
-    Ic[i].m = prog.define(Ic[i].m);
-    Ic[i].h = define(prog, Ic[i].h);
-    Ic[i].J = define(prog, Ic[i].J);
-    int p = kin.bodies[i].parent;
-    if (p < 0) continue;
-    auto up = static_cast<std::size_t>(p);
-    Fc[up] = add(Fc[up], Fc[i]);
-    Ic[up].m = Ic[up].m + Ic[i].m;
-    Ic[up].h = add(Ic[up].h, Ic[i].h);
-    for (int a = 0; a < 3; ++a)
-      for (int c = 0; c < 3; ++c) Ic[up].J[a][c] = Ic[up].J[a][c] + Ic[i].J[a][c];
-  }
-
-  // Residual k − q from the joints, M from composite inertias.
-  eq.residual.assign(f, 0);
-  struct Column { std::size_t body; const Spatial* phi; Spatial force; };
-  std::vector<std::vector<Column>> by_coordinate(f);
-  for (std::size_t i = 0; i < nb; ++i)
-    for (const auto& col : kin.bodies[i].columns) {
-      auto j = static_cast<std::size_t>(col.coordinate);
-      eq.residual[j] += dot(col.phi, Fc[i]);
-      by_coordinate[j].push_back({i, &col.phi, define(prog, apply(Ic[i], col.phi))});
-    }
-  eq.M.assign(f, std::vector<ex>(f, 0));
-  for (std::size_t j = 0; j < f; ++j)
-    for (std::size_t k = j; k < f; ++k) {
-      ex m = 0;
-      for (const auto& a : by_coordinate[j])
-        for (const auto& b : by_coordinate[k]) {
-          int ia = static_cast<int>(a.body), ib = static_cast<int>(b.body);
-          if (kin.is_ancestor_or_self(ia, ib))
-            m += dot(*a.phi, b.force);
-          else if (kin.is_ancestor_or_self(ib, ia))
-            m += dot(*b.phi, a.force);
+  if (options.projection == Projection::naive) {
+    // J̄_i column by column (coordinate j: the sum of the φ with coordinate j on i's root path),
+    // then M += J̄_iᵀ (Ī_i J̄_i) and k − q += J̄_iᵀ f̄_i for every body, no subtree sums.
+    eq.residual.assign(f, 0);
+    eq.M.assign(f, std::vector<ex>(f, 0));
+    for (std::size_t i = 0; i < nb; ++i) {
+      std::vector<std::pair<std::size_t, Spatial>> J;  // (coordinate, column), root path order
+      for (int k = static_cast<int>(i); k >= 0; k = kin.bodies[static_cast<std::size_t>(k)].parent)
+        for (const auto& col : kin.bodies[static_cast<std::size_t>(k)].columns) {
+          auto j = static_cast<std::size_t>(col.coordinate);
+          auto it = std::find_if(J.begin(), J.end(), [j](const auto& c) { return c.first == j; });
+          if (it == J.end())
+            J.emplace_back(j, col.phi);
+          else
+            it->second = add(it->second, col.phi);
         }
-      eq.M[j][k] = eq.M[k][j] = m;
+      std::vector<Spatial> IJ;
+      for (auto& c : J) {
+        c.second = define(prog, c.second);
+        IJ.push_back(define(prog, apply(kin.bodies[i].inertia, c.second)));
+      }
+      for (std::size_t a = 0; a < J.size(); ++a) {
+        eq.residual[J[a].first] += dot(J[a].second, wrench[i]);
+        for (std::size_t b = 0; b < J.size(); ++b)
+          if (J[a].first <= J[b].first) eq.M[J[a].first][J[b].first] += dot(J[a].second, IJ[b]);
+      }
     }
+    for (std::size_t j = 0; j < f; ++j)
+      for (std::size_t k = j + 1; k < f; ++k) eq.M[k][j] = eq.M[j][k];
+  } else {
+    // Backward pass: composite wrenches and composite inertias.
+    std::vector<Spatial> Fc = wrench;
+    std::vector<SpatialInertia> Ic(nb);
+    for (std::size_t i = 0; i < nb; ++i) Ic[i] = kin.bodies[i].inertia;
+    for (std::size_t i = nb; i-- > 0;) {
+      Fc[i] = define(prog, Fc[i]);
+      Ic[i].m = prog.define(Ic[i].m);
+      Ic[i].h = define(prog, Ic[i].h);
+      Ic[i].J = define(prog, Ic[i].J);
+      int p = kin.bodies[i].parent;
+      if (p < 0) continue;
+      auto up = static_cast<std::size_t>(p);
+      Fc[up] = add(Fc[up], Fc[i]);
+      Ic[up].m = Ic[up].m + Ic[i].m;
+      Ic[up].h = add(Ic[up].h, Ic[i].h);
+      for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) Ic[up].J[a][c] = Ic[up].J[a][c] + Ic[i].J[a][c];
+    }
+
+    // Residual k − q from the joints, M from composite inertias.
+    eq.residual.assign(f, 0);
+    struct Column { std::size_t body; const Spatial* phi; Spatial force; };
+    std::vector<std::vector<Column>> by_coordinate(f);
+    for (std::size_t i = 0; i < nb; ++i)
+      for (const auto& col : kin.bodies[i].columns) {
+        auto j = static_cast<std::size_t>(col.coordinate);
+        eq.residual[j] += dot(col.phi, Fc[i]);
+        by_coordinate[j].push_back({i, &col.phi, define(prog, apply(Ic[i], col.phi))});
+      }
+    eq.M.assign(f, std::vector<ex>(f, 0));
+    for (std::size_t j = 0; j < f; ++j)
+      for (std::size_t k = j; k < f; ++k) {
+        ex m = 0;
+        for (const auto& a : by_coordinate[j])
+          for (const auto& b : by_coordinate[k]) {
+            int ia = static_cast<int>(a.body), ib = static_cast<int>(b.body);
+            if (kin.is_ancestor_or_self(ia, ib))
+              m += dot(*a.phi, b.force);
+            else if (kin.is_ancestor_or_self(ib, ia))
+              m += dot(*b.phi, a.force);
+          }
+        eq.M[j][k] = eq.M[k][j] = m;
+      }
+  }
 
   // Conservative and dissipative elements: q = −∂V/∂y − ∂R/∂ẏ.
   ex V = 0, R = 0;

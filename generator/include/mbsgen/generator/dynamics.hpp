@@ -30,9 +30,26 @@ struct Equations {
   ExMatrix JT, JR;                          ///< per body 3×f: centre-of-mass and angular Jacobians
 };
 
+/// How derive() projects the Newton–Euler equations of the bodies onto the coordinates.
+enum class Projection {
+  /// Composite-rigid-body and recursive Newton–Euler forms: subtree sums I^c and F^c, then
+  /// M_jk = φ_jᵀ I^c φ_k and (k − q)_j = φ_jᵀ F^c (the default; structure-aware).
+  composite,
+  /// The textbook projection body by body, M = Σ_i J̄_iᵀ Ī_i J̄_i and k − q = Σ_i J̄_iᵀ f̄_i, with
+  /// J̄_i the 6×f spatial Jacobian of body i (sums of φ along its root path), Ī_i its spatial
+  /// inertia and f̄_i its inertial-minus-applied wrench. The same matrices with more operations;
+  /// kept for the comparison in bench/ (docs/accuracy-vs-time.md) and its test.
+  naive
+};
+
+/// Options of derive().
+struct DeriveOptions {
+  Projection projection = Projection::composite;
+};
+
 /// Derives the equations of a validated model. When model.inertial_velocity_terms() is false
 /// (a scene that drops them), k(y, ẏ) has no velocity-quadratic inertia terms: the residual is
 /// then exact at ẏ = 0 only.
-Equations derive(const Model& model);
+Equations derive(const Model& model, const DeriveOptions& options = {});
 
 }  // namespace mbsgen
