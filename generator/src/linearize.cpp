@@ -1,5 +1,7 @@
 #include "mbsgen/generator/linearize.hpp"
 
+#include "point_evaluator.hpp"
+
 #include <algorithm>
 #include <cstdint>
 #include <unordered_map>
@@ -9,85 +11,6 @@ namespace mbsgen {
 using GiNaC::ex;
 
 namespace {
-
-// Values of program expressions at one point of the variables, in floating point of kDigits
-// decimal digits (CLN). Reads the program's definitions only (defines nothing).
-class PointEvaluator {
- public:
-  static constexpr long kDigits = 50;
-
-  /// point: a value for every variable that the expressions use.
-  PointEvaluator(const Program& program, const GiNaC::exmap& point) : prog_(program) {
-    for (const auto& [x, v] : point) values_.emplace(x, float_of(v));
-  }
-
-  std::vector<GiNaC::numeric> evaluate(const std::vector<ex>& entries) {
-    const auto& defs = prog_.definitions();
-    std::vector<char> needed(defs.size(), 0);
-    std::vector<ex> stack(entries);
-    while (!stack.empty()) {
-      ex e = stack.back();
-      stack.pop_back();
-      if (GiNaC::is_a<GiNaC::symbol>(e)) {
-        const long i = prog_.index_of(e);
-        if (i >= 0 && !needed[static_cast<std::size_t>(i)] && !values_.count(e)) {
-          needed[static_cast<std::size_t>(i)] = 1;
-          stack.push_back(defs[static_cast<std::size_t>(i)].value);
-        }
-        continue;
-      }
-      for (std::size_t i = 0; i < e.nops(); ++i) stack.push_back(e.op(i));
-    }
-    // A definition refers to earlier ones only.
-    for (std::size_t i = 0; i < defs.size(); ++i)
-      if (needed[i]) values_.emplace(defs[i].symbol, number(defs[i].value));
-    std::vector<GiNaC::numeric> out;
-    out.reserve(entries.size());
-    for (const ex& e : entries) out.push_back(number(e));
-    return out;
-  }
-
- private:
-  static GiNaC::numeric float_of(const ex& e) {
-    const ex v = GiNaC::evalf(e);
-    if (!GiNaC::is_a<GiNaC::numeric>(v)) throw std::runtime_error("not a number");
-    return GiNaC::ex_to<GiNaC::numeric>(v);
-  }
-
-  GiNaC::numeric number(const ex& e) const {
-    using GiNaC::is_a;
-    if (is_a<GiNaC::numeric>(e)) return GiNaC::ex_to<GiNaC::numeric>(e);
-    if (is_a<GiNaC::symbol>(e)) {
-      auto it = values_.find(e);
-      if (it == values_.end()) throw std::runtime_error("unbound symbol");
-      return it->second;
-    }
-    if (is_a<GiNaC::add>(e)) {
-      GiNaC::numeric sum = 0;
-      for (std::size_t i = 0; i < e.nops(); ++i) sum += number(e.op(i));
-      return sum;
-    }
-    if (is_a<GiNaC::mul>(e)) {
-      GiNaC::numeric product = 1;
-      for (std::size_t i = 0; i < e.nops(); ++i) product *= number(e.op(i));
-      return product;
-    }
-    if (is_a<GiNaC::power>(e)) {
-      const GiNaC::numeric base = number(e.op(0)), exponent = number(e.op(1));
-      if (exponent.is_integer()) return base.power(exponent);
-      return GiNaC::ex_to<GiNaC::numeric>(base.evalf()).power(exponent);
-    }
-    if (is_a<GiNaC::function>(e)) {
-      GiNaC::exvector args;
-      for (std::size_t i = 0; i < e.nops(); ++i) args.push_back(number(e.op(i)));
-      return float_of(GiNaC::function(GiNaC::ex_to<GiNaC::function>(e).get_serial(), args));
-    }
-    return float_of(e);  // constants such as Pi
-  }
-
-  const Program& prog_;
-  std::unordered_map<ex, GiNaC::numeric, std::hash<ex>, GiNaC::ex_is_equal> values_;
-};
 
 struct Structure {
   bool D_zero = false, G_zero = false, N_zero = false;
@@ -109,7 +32,7 @@ Structure structure_of(const Equations& eq, const LinearEquations& lin, bool at_
       for (std::size_t j = 0; j < f; ++j) entries.push_back((*A)[i][j]);
   Structure s{true, true, true};
   const long digits = GiNaC::Digits;
-  GiNaC::Digits = PointEvaluator::kDigits;
+  GiNaC::Digits = detail::PointEvaluator::kDigits;
   std::uint64_t state = 0x2545f4914f6cdd1dULL;
   try {
     for (int point = 0; point < 2; ++point) {
@@ -127,7 +50,7 @@ Structure structure_of(const Equations& eq, const LinearEquations& lin, bool at_
           values[eq.yd[k]] = GiNaC::evalf(lin.yd0[k].subs(p, GiNaC::subs_options::no_pattern));
         }
       }
-      const std::vector<GiNaC::numeric> v = PointEvaluator(eq.program, values).evaluate(entries);
+      const std::vector<GiNaC::numeric> v = detail::PointEvaluator(eq.program, values).evaluate(entries);
       auto at = [&](std::size_t matrix, std::size_t i, std::size_t j) { return v[matrix * f * f + i * f + j]; };
       for (std::size_t matrix = 0; matrix < 2; ++matrix) {
         GiNaC::numeric scale = 0, sym = 0, skew = 0;

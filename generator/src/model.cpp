@@ -2,6 +2,8 @@
 
 #include "mbsgen/generator/scene.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <cctype>
 #include <cmath>
 #include <functional>
@@ -237,6 +239,49 @@ double numeric_value(const GiNaC::ex& e, const GiNaC::exmap& defaults, bool& ok)
   return ok ? GiNaC::ex_to<GiNaC::numeric>(v).to_double() : 0.0;
 }
 
+// The principal moments of a symmetric 3×3 tensor in ascending order (Eigen's closed-form
+// solver for 3×3 self-adjoint matrices).
+Eigen::Vector3d principal_moments(const Mat3& I, const GiNaC::exmap& defaults, bool& ok) {
+  Eigen::Matrix3d A;
+  ok = true;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      bool entry_ok = false;
+      A(i, j) = numeric_value(I[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)], defaults, entry_ok);
+      ok = ok && entry_ok && std::isfinite(A(i, j));
+    }
+  if (!ok) return Eigen::Vector3d::Zero();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(A, Eigen::EigenvaluesOnly);
+  return es.eigenvalues();
+}
+
+bool inertia_is_zero(const Mat3& I, const GiNaC::exmap& defaults) {
+  bool ok = false;
+  return principal_moments(I, defaults, ok).cwiseAbs().maxCoeff() == 0 && ok;
+}
+
+std::string inertia_problem(const Mat3& I, const GiNaC::exmap& defaults) {
+  bool ok = false;
+  const Eigen::Vector3d d = principal_moments(I, defaults, ok);
+  if (!ok) return "an inertia tensor that is not numeric (or not finite) with the default parameter values";
+  // A tensor about the centre of mass has principal moments A = ∫(y²+z²) dm, … so that
+  // A, B, C ≥ 0 and A + B ≥ C (equality for a flat body). Point masses (all zero) and slender
+  // rods (one zero) are allowed idealizations. The tolerance covers the rounding of the
+  // closed-form eigenvalues and of decimal inputs: 1e-9 of the largest moment.
+  const double tol = 1e-9 * d.cwiseAbs().maxCoeff();
+  std::ostringstream moments;
+  moments.precision(6);
+  moments << d(0) << ", " << d(1) << ", " << d(2);
+  if (d(0) < -tol)
+    return "an inertia tensor that is not positive semi-definite (principal moments " + moments.str() +
+           " kg m^2)";
+  if (d(0) + d(1) < d(2) - tol)
+    return "an inertia tensor that violates the triangle inequality: its principal moments " +
+           moments.str() + " kg m^2 have A + B < C, which no mass distribution gives";
+  return {};
+}
+
 }  // namespace
 
 void Model::validate() const {
@@ -294,6 +339,12 @@ void Model::validate() const {
       for (int j = 0; j < 3; ++j)
         if (!(b.inertia[i][j] - b.inertia[j][i]).is_zero())
           throw ModelError(b.where, "body '" + b.name + "': the inertia tensor is not symmetric");
+    const std::string inertia_error = inertia_problem(b.inertia, defaults);
+    if (!inertia_error.empty()) throw ModelError(b.where, "body '" + b.name + "' has " + inertia_error);
+    if (m == 0 && !inertia_is_zero(b.inertia, defaults))
+      throw ModelError(b.where, "body '" + b.name +
+                                    "' has zero mass but a nonzero inertia tensor (give it a mass, "
+                                    "or omit both for a massless frame)");
   }
   for (const auto& m : markers_) {
     if (m.body != kWorld && !body_index_.count(m.body))

@@ -583,7 +583,13 @@ class Reader {
 
   void read_parameters(const Entry* e);
   void read_named_list(const Entry* e, const std::string& what, bool coordinates);
+  GiNaC::exmap parameter_values() const {
+    GiNaC::exmap values;
+    for (const auto& p : model_->parameters()) values[p.symbol] = GiNaC::numeric(p.value);
+    return values;
+  }
   void read_body(const YAML::Node& n, const std::set<std::string>& later_bodies);
+  std::map<std::string, std::string> declared_parents_;  ///< body → parent as written in the file
   void read_marker(const YAML::Node& n, const std::string& body, const YAML::Node* body_node);
   void read_force(const YAML::Node& n, std::map<std::string, int>& counters);
   void read_output(const YAML::Node& n);
@@ -636,7 +642,10 @@ Model Reader::read() {
   const std::vector<YAML::Node> bodies = list(find(top, "bodies"), "bodies");
   std::set<std::string> body_names;
   for (const auto& b : bodies)
-    if (b.IsMap() && b["name"] && b["name"].IsScalar()) body_names.insert(b["name"].Scalar());
+    if (b.IsMap() && b["name"] && b["name"].IsScalar()) {
+      body_names.insert(b["name"].Scalar());
+      if (b["parent"] && b["parent"].IsScalar()) declared_parents_[b["name"].Scalar()] = b["parent"].Scalar();
+    }
   for (const auto& b : bodies) read_body(b, body_names);
 
   for (const auto& m : list(find(top, "markers"), "markers")) read_marker(m, "", nullptr);
@@ -733,6 +742,16 @@ void Reader::read_body(const YAML::Node& n, const std::set<std::string>& all_bod
       }
       if (!defined) {
         if (b.parent == b.name) fail(pn, what + " cannot be its own parent");
+        // A parent defined later: either out of order or, when its chain of parents comes back to
+        // this body, a cycle with no path to the world.
+        std::string chain = "'" + b.name + "'";
+        for (std::string at = b.parent; declared_parents_.count(at) && chain.size() < 4096;
+             at = declared_parents_.at(at)) {
+          chain += " -> '" + at + "'";
+          if (at == b.name)
+            fail(pn, "bodies " + chain + " form a cycle: every body needs a path to '" +
+                         std::string(kWorld) + "'");
+        }
         if (all_bodies.count(b.parent))
           fail(pn, "parent '" + b.parent + "' of " + what +
                        " must be defined before it (bodies are listed parents first)");
@@ -748,7 +767,12 @@ void Reader::read_body(const YAML::Node& n, const std::set<std::string>& all_bod
   if (rot && rot_m) fail(rot_m->key, what + ": give either 'rotation' or 'rotation_matrix', not both");
   if (rot) b.rotations = rotations(*rot, "a rotation", Scope::positions);
   if (rot_m) b.rotation_matrix = mat3(value(*rot_m), "a rotation matrix", Scope::positions);
-  if (const Entry* m = find(f, "mass")) b.mass = expr(*m, "a mass", Scope::parameters);
+  if (const Entry* m = find(f, "mass")) {
+    b.mass = expr(*m, "a mass", Scope::parameters);
+    const GiNaC::ex m0 = GiNaC::evalf(b.mass.subs(parameter_values(), GiNaC::subs_options::no_pattern));
+    if (GiNaC::is_a<GiNaC::numeric>(m0) && GiNaC::ex_to<GiNaC::numeric>(m0).is_zero())
+      fail(value(*m), what + " has zero mass; omit 'mass' (and 'inertia') for a massless frame");
+  }
   if (const Entry* c = find(f, "com")) b.com = vec3(*c, "a centre of mass", Scope::parameters);
   if (const Entry* i = find(f, "inertia")) {
     const YAML::Node& in = value(*i);

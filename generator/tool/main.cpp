@@ -1,5 +1,6 @@
 // The mbsgen command: check, info and generate a model; `mbsgen linear` analyses raw matrices.
 // Exit codes: 0 success, 1 a bad model or failed analysis, 2 a usage error.
+#include "mbsgen/generator/check.hpp"
 #include "mbsgen/generator/emit.hpp"
 #include "mbsgen/generator/scene.hpp"
 #include "mbsgen/generator/emit_api.hpp"
@@ -111,7 +112,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::string model_file, out_dir, scene = "full", id;
   bool no_cse = false;
-  auto* check = app.add_subcommand("check", "read and validate a model file");
+  auto* check = app.add_subcommand("check", "read and validate a model file (and its operating point)");
   check->add_option("MODEL", model_file, "model file (YAML)")->required();
   auto* info = app.add_subcommand("info", "scenes, effects, kernels and operation counts");
   info->add_option("MODEL", model_file, "model file (YAML)")->required();
@@ -133,14 +134,15 @@ int main(int argc, char** argv) {
   try {
     auto t0 = std::chrono::steady_clock::now();
     mbsgen::Model model = mbsgen::read_model_file(model_file);
+    const mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
+    mbsgen::Equations eq = mbsgen::derive(pruned);
+    mbsgen::LinearEquations lin = mbsgen::linearize(eq);
+    mbsgen::check_operating_point(eq, lin);
     if (*check) {
       std::cout << model_file << ": ok (" << model.bodies().size() << " bodies, "
                 << model.coordinates().size() << " coordinates)\n";
       return 0;
     }
-    const mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
-    mbsgen::Equations eq = mbsgen::derive(pruned);
-    mbsgen::LinearEquations lin = mbsgen::linearize(eq);
     mbsgen::EmitOptions options;
     options.cse = !no_cse;
     options.source_file = model_file;

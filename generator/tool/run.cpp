@@ -4,6 +4,7 @@
 // starts at once and any edit of the model rebuilds it. Nothing is written outside the cache.
 #include "run.hpp"
 
+#include "mbsgen/generator/check.hpp"
 #include "mbsgen/generator/emit.hpp"
 #include "mbsgen/generator/emit_api.hpp"
 #include "mbsgen/generator/scene.hpp"
@@ -106,6 +107,7 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
     const Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
     Equations eq = derive(model);
     LinearEquations lin = linearize(eq);
+    check_operating_point(eq, lin);
     EmitOptions options;
     options.scene = scene;
     options.source_file = model_file;

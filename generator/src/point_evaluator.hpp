@@ -1,0 +1,94 @@
+// Evaluating program expressions at one point in CLN floating point (internal to the generator:
+// linearize.cpp decides structural zeros with it, check.cpp checks the operating point).
+#pragma once
+
+#include "mbsgen/generator/program.hpp"
+
+#include <stdexcept>
+#include <unordered_map>
+#include <vector>
+
+namespace mbsgen::detail {
+
+using GiNaC::ex;
+
+// Values of program expressions at one point of the variables, in floating point of kDigits
+// decimal digits (CLN). Reads the program's definitions only (defines nothing).
+class PointEvaluator {
+ public:
+  static constexpr long kDigits = 50;
+
+  /// point: a value for every variable that the expressions use.
+  PointEvaluator(const Program& program, const GiNaC::exmap& point) : prog_(program) {
+    for (const auto& [x, v] : point) values_.emplace(x, float_of(v));
+  }
+
+  std::vector<GiNaC::numeric> evaluate(const std::vector<ex>& entries) {
+    const auto& defs = prog_.definitions();
+    std::vector<char> needed(defs.size(), 0);
+    std::vector<ex> stack(entries);
+    while (!stack.empty()) {
+      ex e = stack.back();
+      stack.pop_back();
+      if (GiNaC::is_a<GiNaC::symbol>(e)) {
+        const long i = prog_.index_of(e);
+        if (i >= 0 && !needed[static_cast<std::size_t>(i)] && !values_.count(e)) {
+          needed[static_cast<std::size_t>(i)] = 1;
+          stack.push_back(defs[static_cast<std::size_t>(i)].value);
+        }
+        continue;
+      }
+      for (std::size_t i = 0; i < e.nops(); ++i) stack.push_back(e.op(i));
+    }
+    // A definition refers to earlier ones only.
+    for (std::size_t i = 0; i < defs.size(); ++i)
+      if (needed[i]) values_.emplace(defs[i].symbol, number(defs[i].value));
+    std::vector<GiNaC::numeric> out;
+    out.reserve(entries.size());
+    for (const ex& e : entries) out.push_back(number(e));
+    return out;
+  }
+
+ private:
+  static GiNaC::numeric float_of(const ex& e) {
+    const ex v = GiNaC::evalf(e);
+    if (!GiNaC::is_a<GiNaC::numeric>(v)) throw std::runtime_error("not a number");
+    return GiNaC::ex_to<GiNaC::numeric>(v);
+  }
+
+  GiNaC::numeric number(const ex& e) const {
+    using GiNaC::is_a;
+    if (is_a<GiNaC::numeric>(e)) return GiNaC::ex_to<GiNaC::numeric>(e);
+    if (is_a<GiNaC::symbol>(e)) {
+      auto it = values_.find(e);
+      if (it == values_.end()) throw std::runtime_error("unbound symbol");
+      return it->second;
+    }
+    if (is_a<GiNaC::add>(e)) {
+      GiNaC::numeric sum = 0;
+      for (std::size_t i = 0; i < e.nops(); ++i) sum += number(e.op(i));
+      return sum;
+    }
+    if (is_a<GiNaC::mul>(e)) {
+      GiNaC::numeric product = 1;
+      for (std::size_t i = 0; i < e.nops(); ++i) product *= number(e.op(i));
+      return product;
+    }
+    if (is_a<GiNaC::power>(e)) {
+      const GiNaC::numeric base = number(e.op(0)), exponent = number(e.op(1));
+      if (exponent.is_integer()) return base.power(exponent);
+      return GiNaC::ex_to<GiNaC::numeric>(base.evalf()).power(exponent);
+    }
+    if (is_a<GiNaC::function>(e)) {
+      GiNaC::exvector args;
+      for (std::size_t i = 0; i < e.nops(); ++i) args.push_back(number(e.op(i)));
+      return float_of(GiNaC::function(GiNaC::ex_to<GiNaC::function>(e).get_serial(), args));
+    }
+    return float_of(e);  // constants such as Pi
+  }
+
+  const Program& prog_;
+  std::unordered_map<ex, GiNaC::numeric, std::hash<ex>, GiNaC::ex_is_equal> values_;
+};
+
+}  // namespace mbsgen::detail
