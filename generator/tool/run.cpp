@@ -27,6 +27,7 @@ namespace mbsgen::tool {
 
 namespace fs = std::filesystem;
 
+#ifdef MBSGEN_RUN_AVAILABLE
 namespace {
 
 std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ULL) {
@@ -83,6 +84,7 @@ std::string read_file(const fs::path& p) {
 }
 
 }  // namespace
+#endif  // MBSGEN_RUN_AVAILABLE
 
 int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args) {
 #ifndef MBSGEN_RUN_AVAILABLE

@@ -9,10 +9,12 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 }
 
+// NaN marks a quantity that is undefined (the damping ratio of λ = 0): null in JSON, an empty
+// field in CSV, "-" in tables; never the string "nan".
 std::string num(double v, bool json) {
   if (!std::isfinite(v)) {
     if (json) return "null";
-    if (std::isnan(v)) return "nan";
+    if (std::isnan(v)) return "";
     return v > 0 ? "inf" : "-inf";
   }
   char buf[40];
@@ -21,7 +23,7 @@ std::string num(double v, bool json) {
 }
 
 std::string short_num(double v) {
-  if (std::isnan(v)) return "nan";
+  if (std::isnan(v)) return "-";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.6e", v);

@@ -2,6 +2,9 @@
 // people, JSON and CSV for programs, full precision in the machine formats.
 #pragma once
 
+#include <CLI/CLI.hpp>
+
+#include <cmath>
 #include <complex>
 #include <ostream>
 #include <string>
@@ -14,10 +17,25 @@
 
 namespace mbsgen::cli {
 
-/// 17 significant digits, or "null" (JSON) / "nan", "inf" for a non-finite value.
+/// 17 significant digits; an undefined value (NaN) is "null" in JSON and an empty field otherwise,
+/// an infinite one "null" in JSON and "inf"/"-inf" otherwise.
 std::string num(double v, bool json);
-/// %.6e, for tables.
+/// %.6e, for tables ("-" for an undefined value, "inf"/"-inf").
 std::string short_num(double v);
+/// A command-line frequency in Hz: a finite number ≥ 0, with a readable message otherwise.
+inline CLI::Validator frequency_hz() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(text, &used);
+          if (used == text.size() && std::isfinite(v) && v >= 0) return "";
+        } catch (const std::exception&) {
+        }
+        return "'" + text + "' is not a frequency in Hz (a finite number >= 0)";
+      },
+      "HZ", "frequency_hz");
+}
 /// Right-aligned in a field of width w.
 std::string pad(const std::string& s, std::size_t w);
 /// A JSON string literal.

@@ -114,8 +114,8 @@ int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
 ;
   frf->add_option("--input", a.input, "input: column of B, 1-based")->check(CLI::Range(1L, 1000000000L));
   frf->add_option("--output", a.output, "output: row of C, 1-based")->check(CLI::Range(1L, 1000000000L));
-  frf->add_option("--from", a.from, "first frequency [Hz]")->check(CLI::NonNegativeNumber);
-  frf->add_option("--to", a.to, "last frequency [Hz]")->check(CLI::NonNegativeNumber);
+  frf->add_option("--from", a.from, "first frequency [Hz]")->check(frequency_hz());
+  frf->add_option("--to", a.to, "last frequency [Hz]")->check(frequency_hz());
   frf->add_option("--points", a.points, "number of frequencies")->check(CLI::Range(1L, 1000000000L));
   frf->add_option("--spacing", a.spacing, "frequency spacing")
       ->check(CLI::IsMember({"log", "linear"}));

@@ -220,8 +220,8 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   add_set(frf);
   frf->add_option("--input", o.input, "input name")->required();
   frf->add_option("--output", o.output, "output name")->required();
-  frf->add_option("--from", o.from, "first frequency [Hz]")->check(CLI::NonNegativeNumber);
-  frf->add_option("--to", o.to, "last frequency [Hz]")->check(CLI::NonNegativeNumber);
+  frf->add_option("--from", o.from, "first frequency [Hz]")->check(frequency_hz());
+  frf->add_option("--to", o.to, "last frequency [Hz]")->check(frequency_hz());
   frf->add_option("--points", o.points, "number of frequencies")->check(CLI::Range(1L, 100000000L));
   frf->add_option("--spacing", o.spacing, "frequency spacing")->check(CLI::IsMember({"log", "linear"}));
   frf->add_option("--method", o.method, "solution method")
