@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Installs the Debian packages mbsgen needs, if any is missing.
+# Installs the Debian packages mbsgen needs, if any is missing, plus any packages named as
+# arguments (scripts/fuzz.sh adds clang and libclang-rt-14-dev; the test suite needs neither).
 # As root: apt-get update, then apt-get install. Otherwise: prints the command and exits 1.
 set -euo pipefail
 packages=(cmake g++ make pkg-config libginac-dev libcln-dev libeigen3-dev libyaml-cpp-dev
-          libcli11-dev libgtest-dev liblapacke-dev libopenblas-dev gnuplot-nox)
+          libcli11-dev libgtest-dev liblapacke-dev libopenblas-dev gnuplot-nox "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

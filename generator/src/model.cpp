@@ -234,7 +234,13 @@ void collect_symbols(const GiNaC::ex& e, std::set<std::string>& out) {
 }
 
 double numeric_value(const GiNaC::ex& e, const GiNaC::exmap& defaults, bool& ok) {
-  GiNaC::ex v = GiNaC::evalf(e.subs(defaults));
+  GiNaC::ex v;
+  try {
+    v = GiNaC::evalf(e.subs(defaults));
+  } catch (const std::exception&) {  // a pole (1/(m - 1) at m = 1), CLN's underflow: no value
+    ok = false;
+    return 0.0;
+  }
   ok = GiNaC::is_a<GiNaC::numeric>(v) && GiNaC::ex_to<GiNaC::numeric>(v).is_real();
   return ok ? GiNaC::ex_to<GiNaC::numeric>(v).to_double() : 0.0;
 }

@@ -1,10 +1,13 @@
 #include "mbsgen/generator/yaml_reader.hpp"
 
+#include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -170,8 +173,8 @@ std::vector<Token> lex(const std::string& s) {
   return out;
 }
 
-// A decimal literal as an exact integer or rational ("0.25" → "(25/100)", "1e-6" → "(1/1000000)").
-std::string exact_number(const Token& t) {
+// A decimal literal as an exact integer or rational ("0.25" → 1/4, "1e-6" → 1/1000000).
+GiNaC::numeric exact_value(const Token& t) {
   const std::string& s = t.text;
   std::size_t epos = s.find_first_of("eE");
   const std::string mantissa = s.substr(0, epos);
@@ -195,14 +198,18 @@ std::string exact_number(const Token& t) {
     digits.erase(dot, 1);
   }
   digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size()));
-  if (digits.empty()) return "0";
-  if (exponent >= 0) return digits + std::string(static_cast<std::size_t>(exponent), '0');
-  return "(" + digits + "/1" + std::string(static_cast<std::size_t>(-exponent), '0') + ")";
+  if (digits.empty()) return 0;
+  const GiNaC::numeric significand(digits.c_str());
+  const GiNaC::numeric scale = GiNaC::numeric(10).power(exponent < 0 ? -exponent : exponent);
+  return exponent >= 0 ? significand * scale : significand / scale;
 }
 
 // Checks the token stream against GiNaC's expression grammar:
 //   expr := unary (('+'|'-'|'*'|'/'|'^') unary)*     unary := ('+'|'-')* primary
 //   primary := number | name | function '(' [expr (',' expr)*] ')' | '(' expr ')'
+// and bounds the nesting: GiNaC's parser, the expression trees and their destructors recurse once
+// per parenthesis, function call and sign (a sign takes the rest of its expression as operand),
+// so deeper nesting would overflow the stack.
 class ExpressionChecker {
  public:
   using SymbolCheck = std::function<void(const Token&)>;
@@ -226,16 +233,27 @@ class ExpressionChecker {
     return tok.kind == Token::Kind::op && std::string(ops).find(tok.text[0]) != std::string::npos;
   }
 
+  static constexpr std::size_t kMaxNesting = 100;
+
+  void nest(const Token& tok) {
+    if (++depth_ > kMaxNesting)
+      throw ExpressionError(tok.pos, "expression nested too deeply (more than " +
+                                         std::to_string(kMaxNesting) +
+                                         " levels of parentheses, function calls and signs)");
+  }
+
   void expr() {
+    const std::size_t outer = depth_;
     unary();
     while (is_op("+-*/^")) {
       ++i_;
       unary();
     }
+    depth_ = outer;
   }
 
   void unary() {
-    while (is_op("+-")) ++i_;
+    while (is_op("+-")) nest(t_[i_++]);
     primary();
   }
 
@@ -253,10 +271,12 @@ class ExpressionChecker {
         return;
       case Token::Kind::op:
         if (tok.text == "(") {
+          nest(tok);
           ++i_;
           expr();
           if (!is_op(")")) throw ExpressionError(t_[i_].pos, "expected ')'");
           ++i_;
+          --depth_;
           return;
         }
         if (tok.text == "*" && i_ > 0 && t_[i_ - 1].text == "*")
@@ -272,6 +292,7 @@ class ExpressionChecker {
     if (!std::binary_search(fns.begin(), fns.end(), name.text))
       throw ExpressionError(name.pos, "unknown function '" + name.text + "'" +
                                           suggestion(name.text, fns));
+    nest(name);
     ++i_;  // '('
     std::size_t args = 0;
     if (!is_op(")")) {
@@ -286,8 +307,11 @@ class ExpressionChecker {
       }
     }
     ++i_;  // ')'
+    --depth_;
+    // GiNaC's prototype table matches 0 arguments as a wildcard (and its reader then reads a
+    // missing argument): every function here takes one or two.
     const auto& table = GiNaC::get_default_reader();
-    if (table.find(GiNaC::prototype(name.text, args)) == table.end()) {
+    if (args == 0 || table.find(GiNaC::prototype(name.text, args)) == table.end()) {
       const std::size_t want = name.text == "atan2" || name.text == "pow" ? 2 : 1;
       throw ExpressionError(name.pos, "function '" + name.text + "' takes " +
                                           std::to_string(want) + " argument" +
@@ -299,6 +323,101 @@ class ExpressionChecker {
   const std::vector<Token>& t_;
   SymbolCheck check_;
   std::size_t i_ = 0;
+  std::size_t depth_ = 0;
+};
+
+// The numbers and names of a checked expression, as placeholder symbols: their values and where
+// they are written.
+struct Leaves {
+  GiNaC::exmap values;
+  std::map<GiNaC::ex, std::size_t, GiNaC::ex_is_less> offsets;
+};
+
+// Rebuilds a tree of placeholders bottom-up with their values, so that GiNaC evaluates one node at
+// a time and each power is checked before it is evaluated: a zero base with an exponent of
+// non-positive real part is a division by zero (refused here: GiNaC's exception would leak the
+// node), and an exact power whose numbers would exceed kMaxPowerBits (10^(10^6), (2*x)^(10^9))
+// is refused instead of being computed. Any other GiNaC error (log(0), tan(Pi/2)) becomes an
+// ExpressionError at the first character of the offending subexpression.
+class Rebuild {
+ public:
+  explicit Rebuild(const Leaves& leaves) : leaves_(leaves) {}
+
+  GiNaC::ex operator()(const GiNaC::ex& e) const {
+    if (GiNaC::is_a<GiNaC::symbol>(e)) return leaves_.values.at(e);
+    if (GiNaC::is_a<GiNaC::numeric>(e)) return e;
+    GiNaC::exvector ops;
+    for (std::size_t i = 0; i < e.nops(); ++i) ops.push_back((*this)(e.op(i)));
+    try {
+      if (GiNaC::is_a<GiNaC::power>(e)) {
+        check_power(ops[0], ops[1], e);
+        return GiNaC::power(ops[0], ops[1]);
+      }
+      if (GiNaC::is_a<GiNaC::add>(e)) return GiNaC::add(ops);
+      if (GiNaC::is_a<GiNaC::mul>(e)) return GiNaC::mul(ops);
+      if (GiNaC::is_a<GiNaC::function>(e))
+        return GiNaC::function(GiNaC::ex_to<GiNaC::function>(e).get_serial(), ops);
+    } catch (const ExpressionError&) {
+      throw;
+    } catch (const std::exception& err) {
+      throw ExpressionError(offset(e), std::string("bad expression: ") + err.what());
+    }
+    throw ExpressionError(offset(e), "bad expression");
+  }
+
+ private:
+  static constexpr std::uint64_t kMaxPowerBits = std::uint64_t{1} << 20;  // 315653 digits
+
+  // Where the subexpression `e` of the placeholder tree starts (its first number or name).
+  std::size_t offset(const GiNaC::ex& e) const {
+    const std::size_t first = first_leaf(e);
+    return first == std::string::npos ? 0 : first;
+  }
+
+  std::size_t first_leaf(const GiNaC::ex& e) const {
+    if (GiNaC::is_a<GiNaC::symbol>(e)) {
+      auto it = leaves_.offsets.find(e);
+      return it == leaves_.offsets.end() ? std::string::npos : it->second;
+    }
+    std::size_t first = std::string::npos;
+    for (std::size_t i = 0; i < e.nops(); ++i) first = std::min(first, first_leaf(e.op(i)));
+    return first;
+  }
+
+  // The largest binary length of a number in `e` (bases of powers only: GiNaC keeps a numeric
+  // power's exponent below 1, so exponents add no length to the result's numbers).
+  static int max_bits(const GiNaC::ex& e) {
+    if (GiNaC::is_a<GiNaC::numeric>(e)) {
+      const GiNaC::numeric& n = GiNaC::ex_to<GiNaC::numeric>(e);
+      if (!n.is_crational()) return 64;
+      return std::max({n.real().numer().int_length(), n.real().denom().int_length(),
+                       n.imag().numer().int_length(), n.imag().denom().int_length()});
+    }
+    if (GiNaC::is_a<GiNaC::power>(e)) return max_bits(e.op(0));
+    int bits = 0;
+    for (std::size_t i = 0; i < e.nops(); ++i) bits = std::max(bits, max_bits(e.op(i)));
+    return bits;
+  }
+
+  void check_power(const GiNaC::ex& base, const GiNaC::ex& exponent, const GiNaC::ex& node) const {
+    if (!GiNaC::is_a<GiNaC::numeric>(exponent)) return;
+    const GiNaC::numeric& n = GiNaC::ex_to<GiNaC::numeric>(exponent);
+    if (base.is_zero()) {
+      if (!n.is_zero() && !n.real().is_positive())
+        throw ExpressionError(offset(node.op(0)), "division by zero");
+      return;
+    }
+    const int base_bits = max_bits(base);
+    if (base_bits <= 1 || !n.is_crational()) return;  // only 0, 1, -1: no growth
+    // The result's numbers have at most |numerator of the exponent| * base_bits bits.
+    const int exponent_bits = std::max(n.real().numer().int_length(), n.imag().numer().int_length());
+    if (exponent_bits > 40 ||
+        (std::uint64_t{1} << exponent_bits) * static_cast<std::uint64_t>(base_bits) > kMaxPowerBits)
+      throw ExpressionError(offset(node), "a power too large to evaluate exactly (its numbers "
+                                          "would exceed 2^20 binary digits)");
+  }
+
+  const Leaves& leaves_;
 };
 
 GiNaC::ex parse_checked(const Model& model, const std::string& text,
@@ -319,20 +438,41 @@ GiNaC::ex parse_checked(const Model& model, const std::string& text,
   };
   ExpressionChecker(tokens, check).run();
 
+  // GiNaC's parser builds the tree with a distinct placeholder symbol for each occurrence of a
+  // number or name, so that parsing evaluates nothing that can fail or grow (x - x is not yet 0,
+  // 10^10^6 not yet a number); Rebuild then puts in the values, checking each power.
+  GiNaC::symtab placeholders;
+  Leaves leaves;
   std::string rewritten;
-  for (const auto& tok : tokens) {
-    if (tok.kind == Token::Kind::end) break;
-    rewritten += tok.kind == Token::Kind::number ? exact_number(tok) : tok.text;
-    rewritten += ' ';
+  for (std::size_t k = 0; k + 1 < tokens.size(); ++k) {
+    const Token& tok = tokens[k];
+    const bool call = tok.kind == Token::Kind::identifier && tokens[k + 1].text == "(" &&
+                      tokens[k + 1].kind == Token::Kind::op;
+    if (tok.kind == Token::Kind::op || call) {
+      rewritten += tok.text + ' ';
+      continue;
+    }
+    const std::string name = "v" + std::to_string(placeholders.size());
+    const GiNaC::symbol placeholder(name);
+    placeholders[name] = placeholder;
+    leaves.offsets[placeholder] = tok.pos;
+    if (tok.kind == Token::Kind::number) leaves.values[placeholder] = exact_value(tok);
+    else if (tok.text == "Pi") leaves.values[placeholder] = GiNaC::Pi;
+    else if (tok.text == "Euler") leaves.values[placeholder] = GiNaC::Euler;
+    else if (tok.text == "Catalan") leaves.values[placeholder] = GiNaC::Catalan;
+    else leaves.values[placeholder] = model.symbol_table().at(tok.text);
+    rewritten += name + ' ';
   }
+  GiNaC::ex tree;
   try {
-    GiNaC::parser reader(model.symbol_table());
+    GiNaC::parser reader(placeholders);
     reader.strict = true;
-    return reader(rewritten);
+    tree = reader(rewritten);
   } catch (const std::exception& e) {
-    // Not expected after the checks above; report GiNaC's own words at the expression.
+    // Not expected after the checks above (but 'a^b^c'); report GiNaC's own words.
     throw ExpressionError(0, std::string("bad expression: ") + e.what());
   }
+  return Rebuild(leaves)(tree);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -386,6 +526,63 @@ Mat3 rotation_matrix(const ElementaryRotation& r) {
   m[j][i] = s;
   m[j][j] = c;
   return m;
+}
+
+// Where the documents of a YAML text start (at most three). Not YAML::LoadAll: yaml-cpp 0.7 loops
+// there forever, allocating an empty document per turn, on a token that cannot start a node such
+// as a stray ',' (jbeder/yaml-cpp#1040, fixed in later releases); such a token is reported here
+// as a YAML::ParserException at the token.
+class DocumentMarks : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark&) override { root_seen_ = false; }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& m, YAML::anchor_t) override { root(m, true); }
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { root(m, false); }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string&) override {
+    root(m, false);
+  }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    root(m, false);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    root(m, false);
+  }
+  void OnMapEnd() override {}
+
+  // The mark of the current document's root node and whether it is an empty (null) node.
+  YAML::Mark mark;
+  bool null_root = false;
+
+ private:
+  void root(const YAML::Mark& m, bool is_null) {
+    if (root_seen_) return;
+    root_seen_ = true;
+    mark = m;
+    null_root = is_null;
+  }
+  bool root_seen_ = false;
+};
+
+std::vector<YAML::Mark> document_marks(const std::string& text) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  DocumentMarks handler;
+  std::vector<YAML::Mark> marks;
+  bool previous_null = false;
+  while (marks.size() < 3 && parser.HandleNextDocument(handler)) {
+    // Two empty documents at the same place: the parser did not move (the bug above).
+    if (handler.null_root && previous_null && handler.mark.pos == marks.back().pos) {
+      const std::size_t pos = static_cast<std::size_t>(std::max(handler.mark.pos, 0));
+      const std::string what = pos < text.size() ? "'" + text.substr(pos, 1) + "'" : "end of file";
+      throw YAML::ParserException(handler.mark, "unexpected " + what);
+    }
+    previous_null = handler.null_root;
+    marks.push_back(handler.mark);
+  }
+  return marks;
 }
 
 class Reader {
@@ -588,6 +785,16 @@ class Reader {
     for (const auto& p : model_->parameters()) values[p.symbol] = GiNaC::numeric(p.value);
     return values;
   }
+  // evalf(e.subs(values)) for the expression written at `n`; a pole (1/(m - 1) with m = 1) or a
+  // floating-point exception of CLN (exp(-1e9999) underflows) is a ModelError at `n`.
+  GiNaC::ex evaluate(const YAML::Node& n, const GiNaC::ex& e, const GiNaC::exmap& values = {}) const {
+    try {
+      return GiNaC::evalf(values.empty() ? e : e.subs(values, GiNaC::subs_options::no_pattern));
+    } catch (const std::exception& err) {
+      fail(n, "cannot evaluate '" + n.Scalar() + "'" +
+                  (values.empty() ? "" : " with the default parameter values") + ": " + err.what());
+    }
+  }
   void read_body(const YAML::Node& n, const std::set<std::string>& later_bodies);
   std::map<std::string, std::string> declared_parents_;  ///< body → parent as written in the file
   void read_marker(const YAML::Node& n, const std::string& body, const YAML::Node* body_node);
@@ -607,19 +814,23 @@ class Reader {
 };
 
 Model Reader::read() {
-  std::vector<YAML::Node> docs;
+  YAML::Node root;
   try {
-    docs = YAML::LoadAll(text_);
-  } catch (const YAML::ParserException& e) {
-    throw ModelError({file_, e.mark.line + 1, e.mark.column + 1}, e.msg);
+    const std::vector<YAML::Mark> documents = document_marks(text_);
+    if (documents.size() > 1) {
+      const YAML::Mark& m = documents[1];
+      throw ModelError({file_, m.line + 1, m.column + 1}, "a model file holds one YAML document");
+    }
+    root = YAML::Load(text_);
+  } catch (const YAML::DeepRecursion& e) {
+    throw ModelError({file_, e.mark.line + 1, e.mark.column + 1},
+                     "YAML nested too deeply (" + std::to_string(e.depth()) + " levels)");
   } catch (const YAML::Exception& e) {
     throw ModelError({file_, e.mark.line + 1, e.mark.column + 1}, e.msg);
   }
-  if (docs.empty() || docs[0].IsNull())
+  if (root.IsNull())
     throw ModelError({file_, 1, 1}, "the model file is empty (expected a map starting with "
                                     "'model: NAME')");
-  if (docs.size() > 1) fail(docs[1], "a model file holds one YAML document");
-  const YAML::Node root = docs[0];
   const Fields top = fields(root, "the model file",
                             {"model", "parameters", "coordinates", "inputs", "bodies", "markers",
                              "forces", "outputs", "operating_point", "scenes"});
@@ -692,7 +903,7 @@ void Reader::read_parameters(const Entry* e) {
     } else if (val.IsNull()) {
       fail(key, "parameter '" + pname + "' has no value");
     }
-    const GiNaC::ex v = GiNaC::evalf(expr(value_node, "a parameter value", Scope::constants));
+    const GiNaC::ex v = evaluate(value_node, expr(value_node, "a parameter value", Scope::constants));
     if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real())
       fail(value_node, "parameter '" + pname + "' must have a real value");
     model_->add_parameter(pname, GiNaC::ex_to<GiNaC::numeric>(v).to_double(), unit, source,
@@ -769,7 +980,7 @@ void Reader::read_body(const YAML::Node& n, const std::set<std::string>& all_bod
   if (rot_m) b.rotation_matrix = mat3(value(*rot_m), "a rotation matrix", Scope::positions);
   if (const Entry* m = find(f, "mass")) {
     b.mass = expr(*m, "a mass", Scope::parameters);
-    const GiNaC::ex m0 = GiNaC::evalf(b.mass.subs(parameter_values(), GiNaC::subs_options::no_pattern));
+    const GiNaC::ex m0 = evaluate(value(*m), b.mass, parameter_values());
     if (GiNaC::is_a<GiNaC::numeric>(m0) && GiNaC::ex_to<GiNaC::numeric>(m0).is_zero())
       fail(value(*m), what + " has zero mass; omit 'mass' (and 'inertia') for a massless frame");
   }
@@ -1087,7 +1298,7 @@ void Reader::read_scene(const YAML::Node& n) {
     range.where = loc(fn);
     auto hz = [&](const char* key) {
       const Entry& e = require(g, key, fn, "a frequency range");
-      const GiNaC::ex v = GiNaC::evalf(expr(e, std::string("a frequency (Hz)"), Scope::constants));
+      const GiNaC::ex v = evaluate(value(e), expr(e, std::string("a frequency (Hz)"), Scope::constants));
       if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real())
         fail(value(e), "a frequency must be a real number (Hz)");
       return GiNaC::ex_to<GiNaC::numeric>(v).to_double();
