@@ -1,6 +1,9 @@
 #include "mbsgen/runtime/generated_model.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <cerrno>
+#include <cstdio>
 #include <cmath>
 #include <cstdlib>
 
@@ -147,6 +150,19 @@ LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
   check_status(k_.linear(op.y0.data(), op.yd0.data(), p_.data(), ptr(M), ptr(Q), ptr(K), ptr(B),
                          ptr(Cy), ptr(Cv)),
                "linear", k_.model);
+  if (f > 0) {
+    const Eigen::VectorXd lambda =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(M, Eigen::EigenvaluesOnly).eigenvalues();
+    const double norm = lambda.cwiseAbs().maxCoeff();
+    // Rounding moves eigenvalues of a symmetric matrix by O(n·u·‖M‖); a margin of 1e-12·n·‖M‖.
+    if (lambda(0) < -1e-12 * static_cast<double>(f) * norm) {
+      char range[80];
+      std::snprintf(range, sizeof range, "%.3g to %.3g", lambda(0), lambda(f - 1));
+      throw Error("GeneratedModel::linear_model: the mass matrix of model '" + std::string(k_.model) +
+                  "' is not positive semi-definite with these parameter values (eigenvalues " +
+                  range + "): a negative mass or inertia?");
+    }
+  }
   return LinearModel(std::move(M), std::move(Q), std::move(K), std::move(B), std::move(Cy),
                      std::move(Cv), name_list(k_.coordinate_names, k_.n_coordinates),
                      name_list(k_.input_names, k_.n_inputs), name_list(k_.output_names, k_.n_outputs),

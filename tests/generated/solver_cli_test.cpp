@@ -41,6 +41,8 @@ TEST(TypedApi, DoublePendulumMatchesClosedForm) {
   EXPECT_EQ(lin.coordinate_units()[0], "rad");
 }
 
+int solve(std::vector<std::string> args, std::string* out_text = nullptr, std::string* err_text = nullptr);
+
 TEST(GeneratedModel, SetByNameAndErrors) {
   mbsgen::GeneratedModel m(double_pendulum::kernels());
   m.set("g=1.62");
@@ -58,7 +60,27 @@ TEST(GeneratedModel, SetByNameAndErrors) {
   EXPECT_THROW(m.output_index("nope"), mbsgen::NameError);
 }
 
-int solve(std::vector<std::string> args, std::string* out_text = nullptr, std::string* err_text = nullptr) {
+// A negative mass makes M indefinite: an error naming the mass matrix, not eigenvalues that look
+// like results (M of the double pendulum with m1 = −3, m2 = 1: [[−2, 1], [1, 1]], eigenvalues
+// −2.30 and 1.30).
+TEST(GeneratedModel, IndefiniteMassMatrixIsAnError) {
+  mbsgen::GeneratedModel m(double_pendulum::kernels());
+  m.set("m1=-3");
+  try {
+    (void)m.linear_model();
+    FAIL() << "an indefinite M was accepted";
+  } catch (const mbsgen::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not positive semi-definite"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("-2.3 to 1.3"), std::string::npos) << e.what();
+  }
+  m.set("m1=0");  // semi-definite (a massless first rod end): allowed, infinite eigenvalues follow
+  EXPECT_NO_THROW((void)m.linear_model());
+  std::string err;
+  EXPECT_EQ(solve({"modes", "--set", "m1=-3"}, nullptr, &err), 1);
+  EXPECT_NE(err.find("not positive semi-definite"), std::string::npos) << err;
+}
+
+int solve(std::vector<std::string> args, std::string* out_text, std::string* err_text) {
   args.insert(args.begin(), "double_pendulum-solve");
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());

@@ -94,7 +94,10 @@ class GeneratedModel {
   /// when a kernel returns a non-finite value.
   OperatingPoint operating_point() const;
 
-  /// M, Q, K, B, C_y, C_v at the operating point, with names and units.
+  /// M, Q, K, B, C_y, C_v at the operating point, with names and units. Throws NonFiniteError
+  /// when a kernel returns a non-finite value, and Error when M is not positive semi-definite
+  /// (smallest eigenvalue below −1e-12·n·‖M‖): no mass distribution gives that, so a parameter
+  /// set this way (a negative mass or inertia) would give numbers that only look like results.
   LinearModel linear_model(const OperatingPoint& op) const;
   LinearModel linear_model() const { return linear_model(operating_point()); }
 
