@@ -1,5 +1,5 @@
-// Scenes benchmark (issue 5 §5, docs/scenes.md): for the spinning rotor, the Jeffcott rotor
-// and the planar chain, the full model against each of its scenes — generation time, operation
+// Scenes benchmark (issue 5 §5, docs/scenes.md): for the middle ear, the spinning rotor, the
+// Jeffcott rotor and the planar chain, the full model against each of its scenes — generation time, operation
 // counts of the emitted kernels, evaluation time of the `linear` kernel, and the time of a
 // whole frequency sweep (kernel at the operating point, LinearModel, FrequencyResponse for every
 // input column and every output row the scene keeps). Times are the best of 21 batches (kernel)
@@ -215,20 +215,27 @@ int main(int argc, char** argv) {
   if (links.empty()) links = {10, 20};
   const fs::path dir = fs::temp_directory_path() / "mbsgen_scenes_bench";
   fs::create_directories(dir);
-  // 1000 frequencies, logarithmic from 0.1 to 100 Hz, for every case alike.
-  Eigen::VectorXd omega(1000);
-  for (Eigen::Index i = 0; i < omega.size(); ++i)
-    omega[i] = 2 * std::acos(-1.0) * 0.1 * std::pow(1000.0, static_cast<double>(i) / static_cast<double>(omega.size() - 1));
+  // 1000 log-spaced frequencies per case: 0.1–100 Hz for the rotors and chains, 100 Hz–10 kHz
+  // (the `transfer` scene's range) for the middle ear.
+  auto frequencies = [](double from_hz, double to_hz) {
+    Eigen::VectorXd omega(1000);
+    for (Eigen::Index i = 0; i < omega.size(); ++i)
+      omega[i] = 2 * std::acos(-1.0) * from_hz *
+                 std::pow(to_hz / from_hz, static_cast<double>(i) / static_cast<double>(omega.size() - 1));
+    return omega;
+  };
 
   struct Case {
     std::string label;
     mbsgen::Model model;
+    Eigen::VectorXd omega;
   };
   std::vector<Case> cases;
-  const std::string textbook = std::string(MBSGEN_SOURCE_DIR) + "/models/textbook/";
-  cases.push_back({"rotor_disk", mbsgen::read_model_file(textbook + "rotor_disk.yaml")});
-  cases.push_back({"jeffcott_rotor", mbsgen::read_model_file(textbook + "jeffcott_rotor.yaml")});
-  for (int n : links) cases.push_back({"chain" + std::to_string(n), excited_chain(n)});
+  const std::string models = std::string(MBSGEN_SOURCE_DIR) + "/models/";
+  cases.push_back({"middle_ear", mbsgen::read_model_file(models + "middle_ear/middle_ear.yaml"), frequencies(100, 1e4)});
+  cases.push_back({"rotor_disk", mbsgen::read_model_file(models + "textbook/rotor_disk.yaml"), frequencies(0.1, 100)});
+  cases.push_back({"jeffcott_rotor", mbsgen::read_model_file(models + "textbook/jeffcott_rotor.yaml"), frequencies(0.1, 100)});
+  for (int n : links) cases.push_back({"chain" + std::to_string(n), excited_chain(n), frequencies(0.1, 100)});
 
   std::printf("| model | scene | kernels | generation [s] | linear ops | all kernels ops | linear [us] | modes [ms] (method) | sweep [ms] | solves |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
@@ -236,7 +243,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> scenes = {mbsgen::kFullScene};
     for (const auto& s : c.model.scenes()) scenes.push_back(s.name);
     for (const auto& s : scenes) {
-      const Row r = measure(c.model, s, c.label, dir, omega);
+      const Row r = measure(c.model, s, c.label, dir, c.omega);
       char sweep[32] = "-", modes[64] = "-";
       if (r.sweep_ms >= 0) std::snprintf(sweep, sizeof sweep, "%.3f", r.sweep_ms);
       if (r.modes_ms >= 0) std::snprintf(modes, sizeof modes, "%.3f (%s)", r.modes_ms, r.modes_method.c_str());
