@@ -12,7 +12,7 @@
 # sanitizer report (the reproducer is in build/fuzz/findings/TARGET/, the log next to it).
 #
 # Environment: FUZZ_SECONDS (per target, default 60), FUZZ_TIMEOUT (per input, s, default 10),
-# FUZZ_RSS_MB (memory limit, default 2048), FUZZ_JOBS (build parallelism, default nproc),
+# FUZZ_RSS_MB (memory limit, default 2048), FUZZ_MAX_LEN (input size, default 20000), FUZZ_JOBS (build parallelism, default nproc),
 # FUZZ_ARGS (extra libFuzzer flags).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,6 +21,7 @@ scripts/deps.sh clang libclang-rt-14-dev
 seconds=${FUZZ_SECONDS:-60}
 timeout=${FUZZ_TIMEOUT:-10}
 rss_mb=${FUZZ_RSS_MB:-2048}
+max_len=${FUZZ_MAX_LEN:-20000}  # bytes: the largest model (middle_ear.yaml, 17 kB) fits
 jobs=${FUZZ_JOBS:-$(nproc)}
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=(model_reader expression)
@@ -71,7 +72,7 @@ for t in "${targets[@]}"; do
   LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp} \
   UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1} \
   "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb="$rss_mb" \
-    -malloc_limit_mb="$rss_mb" -dict=fuzz/mbsgen.dict -print_final_stats=1 \
+    -malloc_limit_mb="$rss_mb" -max_len="$max_len" -dict=fuzz/mbsgen.dict -print_final_stats=1 \
     -artifact_prefix="$findings/" ${FUZZ_ARGS:-} \
     "$corpus" "$seeds" "tests/data/fuzz_regressions/$t" > "$log" 2>&1
   rc=$?

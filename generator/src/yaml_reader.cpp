@@ -1,5 +1,7 @@
 #include "mbsgen/generator/yaml_reader.hpp"
 
+#include "checked_subs.hpp"
+
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
@@ -333,41 +335,22 @@ struct Leaves {
   std::map<GiNaC::ex, std::size_t, GiNaC::ex_is_less> offsets;
 };
 
-// Rebuilds a tree of placeholders bottom-up with their values, so that GiNaC evaluates one node at
-// a time and each power is checked before it is evaluated: a zero base with an exponent of
-// non-positive real part is a division by zero (refused here: GiNaC's exception would leak the
-// node), and an exact power whose numbers would exceed kMaxPowerBits (10^(10^6), (2*x)^(10^9))
-// is refused instead of being computed. Any other GiNaC error (log(0), tan(Pi/2)) becomes an
-// ExpressionError at the first character of the offending subexpression.
+// Puts the values into a tree of placeholders (checked_subs: each power is checked before GiNaC
+// evaluates it, see checked_subs.hpp); a refusal or an error of GiNaC (log(0), tan(Pi/2)) becomes
+// an ExpressionError at the first character of the offending subexpression.
 class Rebuild {
  public:
   explicit Rebuild(const Leaves& leaves) : leaves_(leaves) {}
 
-  GiNaC::ex operator()(const GiNaC::ex& e) const {
-    if (GiNaC::is_a<GiNaC::symbol>(e)) return leaves_.values.at(e);
-    if (GiNaC::is_a<GiNaC::numeric>(e)) return e;
-    GiNaC::exvector ops;
-    for (std::size_t i = 0; i < e.nops(); ++i) ops.push_back((*this)(e.op(i)));
+  GiNaC::ex operator()(const GiNaC::ex& tree) const {
     try {
-      if (GiNaC::is_a<GiNaC::power>(e)) {
-        check_power(ops[0], ops[1], e);
-        return GiNaC::power(ops[0], ops[1]);
-      }
-      if (GiNaC::is_a<GiNaC::add>(e)) return GiNaC::add(ops);
-      if (GiNaC::is_a<GiNaC::mul>(e)) return GiNaC::mul(ops);
-      if (GiNaC::is_a<GiNaC::function>(e))
-        return GiNaC::function(GiNaC::ex_to<GiNaC::function>(e).get_serial(), ops);
-    } catch (const ExpressionError&) {
-      throw;
-    } catch (const std::exception& err) {
-      throw ExpressionError(offset(e), std::string("bad expression: ") + err.what());
+      return detail::checked_subs(tree, leaves_.values);
+    } catch (const detail::EvaluationError& e) {
+      throw ExpressionError(offset(e.where()), std::string("bad expression: ") + e.what());
     }
-    throw ExpressionError(offset(e), "bad expression");
   }
 
  private:
-  static constexpr std::uint64_t kMaxPowerBits = std::uint64_t{1} << 20;  // 315653 digits
-
   // Where the subexpression `e` of the placeholder tree starts (its first number or name).
   std::size_t offset(const GiNaC::ex& e) const {
     const std::size_t first = first_leaf(e);
@@ -382,39 +365,6 @@ class Rebuild {
     std::size_t first = std::string::npos;
     for (std::size_t i = 0; i < e.nops(); ++i) first = std::min(first, first_leaf(e.op(i)));
     return first;
-  }
-
-  // The largest binary length of a number in `e` (bases of powers only: GiNaC keeps a numeric
-  // power's exponent below 1, so exponents add no length to the result's numbers).
-  static int max_bits(const GiNaC::ex& e) {
-    if (GiNaC::is_a<GiNaC::numeric>(e)) {
-      const GiNaC::numeric& n = GiNaC::ex_to<GiNaC::numeric>(e);
-      if (!n.is_crational()) return 64;
-      return std::max({n.real().numer().int_length(), n.real().denom().int_length(),
-                       n.imag().numer().int_length(), n.imag().denom().int_length()});
-    }
-    if (GiNaC::is_a<GiNaC::power>(e)) return max_bits(e.op(0));
-    int bits = 0;
-    for (std::size_t i = 0; i < e.nops(); ++i) bits = std::max(bits, max_bits(e.op(i)));
-    return bits;
-  }
-
-  void check_power(const GiNaC::ex& base, const GiNaC::ex& exponent, const GiNaC::ex& node) const {
-    if (!GiNaC::is_a<GiNaC::numeric>(exponent)) return;
-    const GiNaC::numeric& n = GiNaC::ex_to<GiNaC::numeric>(exponent);
-    if (base.is_zero()) {
-      if (!n.is_zero() && !n.real().is_positive())
-        throw ExpressionError(offset(node.op(0)), "division by zero");
-      return;
-    }
-    const int base_bits = max_bits(base);
-    if (base_bits <= 1 || !n.is_crational()) return;  // only 0, 1, -1: no growth
-    // The result's numbers have at most |numerator of the exponent| * base_bits bits.
-    const int exponent_bits = std::max(n.real().numer().int_length(), n.imag().numer().int_length());
-    if (exponent_bits > 40 ||
-        (std::uint64_t{1} << exponent_bits) * static_cast<std::uint64_t>(base_bits) > kMaxPowerBits)
-      throw ExpressionError(offset(node), "a power too large to evaluate exactly (its numbers "
-                                          "would exceed 2^20 binary digits)");
   }
 
   const Leaves& leaves_;
@@ -786,10 +736,11 @@ class Reader {
     return values;
   }
   // evalf(e.subs(values)) for the expression written at `n`; a pole (1/(m - 1) with m = 1) or a
-  // floating-point exception of CLN (exp(-1e9999) underflows) is a ModelError at `n`.
+  // floating-point exception of CLN (exp(-1e9999) underflows) is a ModelError at `n`. (Through
+  // checked_subs: GiNaC's own subs leaks the node whose evaluation throws.)
   GiNaC::ex evaluate(const YAML::Node& n, const GiNaC::ex& e, const GiNaC::exmap& values = {}) const {
     try {
-      return GiNaC::evalf(values.empty() ? e : e.subs(values, GiNaC::subs_options::no_pattern));
+      return GiNaC::evalf(values.empty() ? e : detail::checked_subs(e, values));
     } catch (const std::exception& err) {
       fail(n, "cannot evaluate '" + n.Scalar() + "'" +
                   (values.empty() ? "" : " with the default parameter values") + ": " + err.what());
