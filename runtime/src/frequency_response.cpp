@@ -412,6 +412,28 @@ FrfMethod parse_frf_method(const std::string& name) {
               "' (expected auto, direct, banded, hessenberg, modal, real)");
 }
 
+// The rule follows docs/accuracy-vs-time.md §5 (the recommendation table; measured by
+// bench/frf_accuracy.cpp, checked by tests/runtime/test_auto_method.cpp): below 12 coordinates
+// direct, the backward-stable reference, since every method costs microseconds there; banded
+// wherever the band is narrow (the fastest at every size and bandwidth up to b = n/4 in the
+// sweep, as accurate as direct); among the dense methods hessenberg once its one-time reduction
+// is paid back (break-even from about 8 frequencies at f = 12 to about 25 from f = 100 on),
+// unless the first-order form is badly conditioned: its error grows like u·κ(M̃)κ(K̃)
+// (speaker_box: 4e-8 against direct's 3e-10), so above 1e8 — or with M or K singular — direct.
+FrfMethod automatic_frf_method(const LinearModel& model, Index frequencies) {
+  const Index n = model.size(), b = model.bandwidth();
+  if (n < 12) return FrfMethod::direct;
+  if (4 * b <= n && b * b <= 16 * n) return FrfMethod::banded;
+  if (frequencies < std::min<Index>(30, std::max<Index>(8, n / 2))) return FrfMethod::direct;
+  // κ₁ of M and K scaled to unit diagonal of M (the coordinates' units divided out).
+  const Eigen::VectorXd d = model.M().diagonal();
+  if (!(d.minCoeff() > 0)) return FrfMethod::direct;
+  const Eigen::VectorXd s = d.cwiseSqrt().cwiseInverse();
+  const double rc_M = Eigen::PartialPivLU<Eigen::MatrixXd>(s.asDiagonal() * model.M() * s.asDiagonal()).rcond();
+  const double rc_K = Eigen::PartialPivLU<Eigen::MatrixXd>(s.asDiagonal() * model.K() * s.asDiagonal()).rcond();
+  return rc_M * rc_K >= 1e-8 ? FrfMethod::hessenberg : FrfMethod::direct;
+}
+
 const char* to_string(FrfFlag flag) {
   switch (flag) {
     case FrfFlag::ok: return "ok";
@@ -928,15 +950,7 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
   im.bzi.resize(p);
 
   FrfMethod m = options_.method;
-  if (m == FrfMethod::automatic) {
-    const Index bw = model_.bandwidth();
-    if (n >= 40 && bw <= std::max<Index>(1, n / 10))
-      m = FrfMethod::banded;
-    else if (n >= 12 && omega.size() >= 8)
-      m = FrfMethod::hessenberg;
-    else
-      m = FrfMethod::direct;
-  }
+  if (m == FrfMethod::automatic) m = automatic_frf_method(model_, omega.size());
   used_ = m;
   switch (m) {
     case FrfMethod::direct: im.prepare_direct(); break;

@@ -16,7 +16,7 @@ namespace mbsgen {
 
 /// How FrequencyResponse solves for each frequency.
 enum class FrfMethod {
-  automatic,   ///< banded for narrow-band models, hessenberg for many frequencies, else direct
+  automatic,   ///< banded, hessenberg or direct by size and conditioning: automatic_frf_method
   direct,      ///< complex LU (zgetrf) of K − Ω²M + iΩQ per frequency, O(f³) each: the reference
   banded,      ///< complex band LU of the same matrix, O(f·b²) each (chains, FE models)
   hessenberg,  ///< one-time Hessenberg(-triangular) reduction, then O(f²) per frequency (Laub 1981)
@@ -28,6 +28,14 @@ enum class FrfMethod {
 const char* to_string(FrfMethod method);
 /// Inverse of to_string (also accepts "auto"); throws mbsgen::Error for an unknown name.
 FrfMethod parse_frf_method(const std::string& name);
+
+/// The method FrfMethod::automatic uses for `model` (f coordinates, half-bandwidth b) and a call
+/// with `frequencies` frequencies (docs/accuracy-vs-time.md §5): direct when f < 12; banded when
+/// 4b ≤ f and b² ≤ 16f; hessenberg when frequencies ≥ min(30, max(8, f/2)) and
+/// rcond₁(M̃)·rcond₁(K̃) ≥ 1e-8, with M̃, K̃ = S M S, S K S and S = diag(M)^(−1/2) (M or K
+/// singular fails the test); otherwise direct. Costs two LU factorizations of f×f matrices when
+/// it gets to the conditioning test, nothing otherwise.
+FrfMethod automatic_frf_method(const LinearModel& model, Eigen::Index frequencies);
 
 /// What to do at (or numerically at) a pole of an undamped system.
 enum class PoleHandling {
