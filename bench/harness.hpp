@@ -1,0 +1,94 @@
+// Timing harness of the accuracy-versus-time benchmarks (bench/frf_accuracy.cpp,
+// bench/modes_accuracy.cpp, bench/generation_cost.cpp; docs/accuracy-vs-time.md): the median of
+// several repetitions, each a batch of calls long enough to be timed, and CSV output. The
+// machine is shared, so medians (not means, not minima) are reported, with the spread (min and
+// max of the repetitions) beside them, and every comparison is a ratio against a baseline
+// measured in the same run.
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace bench {
+
+using Clock = std::chrono::steady_clock;
+
+inline double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// Median, smallest and largest of the repetitions, in seconds per call.
+struct Timing {
+  double median = NAN, min = NAN, max = NAN;
+  int repetitions = 0;
+  long calls_per_repetition = 0;
+};
+
+inline double median_of(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// Times `call`: a first call sizes the batch; then `repetitions` batches of calls, each at least
+/// `min_batch_s` long. When one call is longer than that, the first call is itself the first
+/// repetition (one call per batch), and a call longer than `long_call_s` is repeated at most
+/// twice more (3 repetitions), one longer than 10·long_call_s not at all (1 repetition), so
+/// that slow cases stay within the run's budget.
+template <class F>
+Timing time_calls(F&& call, int repetitions, double min_batch_s = 0.05, double long_call_s = 2.0) {
+  const auto t0 = Clock::now();
+  call();
+  const double first = seconds_since(t0);
+  Timing t;
+  std::vector<double> per_call;
+  t.calls_per_repetition = first >= min_batch_s ? 1 : static_cast<long>(std::ceil(min_batch_s / std::max(first, 1e-9)));
+  t.repetitions = first > 10 * long_call_s ? 1 : first > long_call_s ? std::min(repetitions, 3) : repetitions;
+  if (first >= min_batch_s) per_call.push_back(first);
+  for (int r = static_cast<int>(per_call.size()); r < t.repetitions; ++r) {
+    const auto t1 = Clock::now();
+    for (long c = 0; c < t.calls_per_repetition; ++c) call();
+    per_call.push_back(seconds_since(t1) / static_cast<double>(t.calls_per_repetition));
+  }
+  t.median = median_of(per_call);
+  t.min = *std::min_element(per_call.begin(), per_call.end());
+  t.max = *std::max_element(per_call.begin(), per_call.end());
+  return t;
+}
+
+/// A CSV file with a fixed header; fields are written as given (no quoting: none of ours holds a
+/// comma).
+class Csv {
+ public:
+  Csv(const std::string& path, const std::string& header) : f_(std::fopen(path.c_str(), "w")) {
+    if (f_) std::fprintf(f_, "%s\n", header.c_str());
+  }
+  ~Csv() {
+    if (f_) std::fclose(f_);
+  }
+  Csv(const Csv&) = delete;
+  Csv& operator=(const Csv&) = delete;
+  bool ok() const { return f_ != nullptr; }
+  void row(const std::vector<std::string>& fields) {
+    for (std::size_t i = 0; i < fields.size(); ++i) std::fprintf(f_, "%s%s", i ? "," : "", fields[i].c_str());
+    std::fprintf(f_, "\n");
+    std::fflush(f_);
+  }
+
+ private:
+  std::FILE* f_;
+};
+
+inline std::string num(double x) {
+  if (std::isnan(x)) return "nan";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", x);
+  return b;
+}
+
+}  // namespace bench

@@ -1,0 +1,120 @@
+#!/usr/bin/python3
+"""SymPy peer of bench/generation_cost.cpp (issue 7 §4, docs/accuracy-vs-time.md).
+
+Builds the N-link planar chain of mbsgen::planar_chain (generator/src/chain.cpp) with
+sympy.physics.mechanics.KanesMethod — point masses m_i at the ends of massless rods l_i,
+revolute joints about z with relative angles q_i (q_1 from the downward vertical), a torsional
+spring k_i and damper c_i on each relative angle, gravity g along -y — derives the equations of
+motion (kanes_equations), linearizes them about q = 0, u = 0 (KanesMethod.linearize with
+A_and_B=False, i.e. without inverting M symbolically) and prints, as it goes, one "key value"
+line per result so that a run stopped by a time limit still reports what it finished:
+
+  sympy_version, derive_s, ops_mass_forcing, linearize_s, ops_linear, cse_s, ops_linear_cse,
+  max_rel_diff (M, C, K at q = 0 with mbsgen's default parameters against the matrices of
+  generation_cost in GEN_MATRICES, when given), done
+
+usage: /usr/bin/python3 bench/peers/sympy_chain.py N [GEN_MATRICES_FILE]
+Run by scripts/bench.sh under `timeout`; needs Debian's python3-sympy.
+"""
+import sys
+import time
+
+import sympy as sp
+import sympy.physics.mechanics as me
+
+
+def say(key, value):
+    print(key, value, flush=True)
+
+
+def build(n):
+    q = me.dynamicsymbols("q1:%d" % (n + 1))
+    u = me.dynamicsymbols("u1:%d" % (n + 1))
+    m = sp.symbols("m1:%d" % (n + 1))
+    l = sp.symbols("l1:%d" % (n + 1))
+    k = sp.symbols("k1:%d" % (n + 1))
+    c = sp.symbols("c1:%d" % (n + 1))
+    g = sp.Symbol("g")
+    world = me.ReferenceFrame("N")
+    origin = me.Point("O")
+    origin.set_vel(world, 0)
+    particles, loads = [], []
+    parent, joint = world, origin
+    for i in range(n):
+        frame = parent.orientnew("A%d" % (i + 1), "Axis", [q[i], parent.z])
+        frame.set_ang_vel(parent, u[i] * parent.z)
+        point = joint.locatenew("P%d" % (i + 1), -l[i] * frame.y)
+        point.v2pt_theory(joint, world, frame)
+        particles.append(me.Particle("pa%d" % (i + 1), point, m[i]))
+        loads.append((point, -m[i] * g * world.y))
+        torque = (-k[i] * q[i] - c[i] * u[i]) * world.z  # on the relative angle q_i
+        loads.append((frame, torque))
+        if i > 0:
+            loads.append((parent, -torque))
+        parent, joint = frame, point
+    kd = [q[i].diff(me.dynamicsymbols._t) - u[i] for i in range(n)]
+    km = me.KanesMethod(world, q_ind=q, u_ind=u, kd_eqs=kd)
+    params = {g: 9.81}
+    for i in range(n):  # mbsgen::planar_chain's defaults
+        params.update({m[i]: 1.0, l[i]: 0.5, k[i]: 10.0, c[i]: 0.1})
+    return km, particles, loads, q, u, params
+
+
+def ops(matrix):
+    return sum(sp.count_ops(e) for e in matrix)
+
+
+def read_matrices(path):
+    mats, name, rows = {}, None, []
+    with open(path) as f:
+        for line in f:
+            line = line.split()
+            if len(line) == 1 and line[0] in ("M", "Q", "K"):
+                if name:
+                    mats[name] = sp.Matrix(rows)
+                name, rows = line[0], []
+            elif line:
+                rows.append([float(x) for x in line])
+    if name:
+        mats[name] = sp.Matrix(rows)
+    return mats
+
+
+def main():
+    n = int(sys.argv[1])
+    say("sympy_version", sp.__version__)
+    t0 = time.perf_counter()
+    km, particles, loads, q, u, params = build(n)
+    km.kanes_equations(particles, loads)
+    say("derive_s", "%.4g" % (time.perf_counter() - t0))
+    say("ops_mass_forcing", ops(km.mass_matrix) + ops(km.forcing))
+    t0 = time.perf_counter()
+    op = {**{qi: 0 for qi in q}, **{ui: 0 for ui in u}}
+    Ml, Al, _, _ = km.linearize(op_point=op, A_and_B=False, simplify=False)
+    say("linearize_s", "%.4g" % (time.perf_counter() - t0))
+    say("ops_linear", ops(Ml) + ops(Al))
+    t0 = time.perf_counter()
+    replacements, reduced = sp.cse(list(Ml) + list(Al))
+    say("cse_s", "%.4g" % (time.perf_counter() - t0))
+    say("ops_linear_cse", sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced))
+    if len(sys.argv) > 2:
+        # Rows n..2n-1 of M_l [q'; u'] = A_l [q; u]: M u' = -K q - C u up to the sign SymPy gives
+        # the dynamic rows (Fr + Fr* = 0 has -M): normalised by the sign of M_11.
+        sub = {**params, **op}
+        Mn = Ml[n:, n:].subs(sub).evalf()
+        Kn = -Al[n:, :n].subs(sub).evalf()
+        Cn = -Al[n:, n:].subs(sub).evalf()
+        if Mn[0, 0] < 0:
+            Mn, Kn, Cn = -Mn, -Kn, -Cn
+        ours = read_matrices(sys.argv[2])
+        diff, scale = 0.0, 0.0
+        for a, b in ((Mn, ours["M"]), (Cn, ours["Q"]), (Kn, ours["K"])):
+            for x, y in zip(a, b):
+                diff = max(diff, abs(float(x) - float(y)))
+                scale = max(scale, abs(float(y)))
+        say("max_rel_diff", "%.3g" % (diff / scale))
+    say("done", 1)
+
+
+if __name__ == "__main__":
+    main()
