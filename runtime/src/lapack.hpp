@@ -29,7 +29,17 @@ inline void check_lapack(lapack_int info, const char* routine, const char* calle
 /// Used where a lower bound is conservative (backward errors become larger, never smaller).
 double norm2_estimate(const Eigen::MatrixXd& A);
 
-/// Numerical rank by QR with column pivoting: #{i : |R_ii| > tol·|R_00|}.
-Eigen::Index numerical_rank(const Eigen::MatrixXd& A, double relative_tolerance);
+/// Numerical rank and null space of a square A from the column-pivoted QR (LAPACK dgeqp3) of its
+/// transpose, Aᵀ P = Q R (a rank-revealing QR).
+struct NullSpace {
+  Eigen::Index rank = 0;  ///< #{leading pivots with |R_ii| > threshold}
+  Eigen::MatrixXd basis;  ///< n×(n − rank) orthonormal: Q(:, rank:n), and A·basis = P·[0; R22ᵀ]
+  double r00 = 0.0;       ///< |R_00|: the largest row norm of A
+  double residual = 0.0;  ///< ‖A·basis‖_F = ‖R22‖_F, the part of A the rank decision discards
+};
+/// The pivot threshold is `tolerance`·|R_00| if `relative`, else `tolerance` (absolute);
+/// `force_rank` ≥ 0 imposes the rank instead (for a left null space of known dimension).
+NullSpace null_space(const Eigen::MatrixXd& A, double tolerance, bool relative,
+                     Eigen::Index force_rank = -1);
 
 }  // namespace mbsgen::detail

@@ -108,7 +108,8 @@ TEST(Modes, EarChainUndampedSymmetricPathAgreesWithGeneralPath) {
 
 TEST(Modes, MasslessCoordinateGivesInfiniteEigenvalues) {
   // Coordinate 3 of 5 has no mass and no damper: det(λ²M + λQ + K) has degree 2n − 2, so two
-  // eigenvalues are infinite (a 2×2 Jordan block at ∞, which QZ perturbs by O(√u)).
+  // eigenvalues are infinite (a 2×2 Jordan block at ∞, deflated before QZ, which would perturb
+  // it by O(√u)).
   Qep p = testmodels::chain({1, 2, 0, 1.5, 1}, {100, 200, 300, 200, 100, 50},
                             {0.1, 0.2, 0, 0, 0.2, 0.1});
   QuadraticEigenSolver s(5);
@@ -120,8 +121,8 @@ TEST(Modes, MasslessCoordinateGivesInfiniteEigenvalues) {
   expect_accurate(p, s);
   for (const Mode& m : s.modes())
     if (m.kind == EigenvalueKind::infinite) {
-      // The infinite eigenvector spans the null space of M: |x_3| = 1.
-      // |x_3| = 1 up to the O(√u) perturbation of the Jordan block at ∞
+      // The infinite eigenvector spans the null space of M: |x_3| = 1 (1e-8 was the O(√u) bar of
+      // the former classification after QZ; ModesDeflation checks it to a few u).
       EXPECT_NEAR(std::abs(m.shape[2]), 1.0, 1e-8);
       EXPECT_TRUE(std::isinf(m.natural_frequency_hz));
     }
@@ -158,8 +159,8 @@ TEST(Modes, FreeFreeChainReportsRigidBodyModeAsZero) {
       expect_backward_stable(p, s);
       for (const Mode& md : s.modes()) {
         if (md.kind == EigenvalueKind::zero) {
-          // rigid-body shape: all coordinates equal, 1/√6 each
-          // equal entries up to the O(√u) perturbation of the Jordan block at 0
+          // rigid-body shape: all coordinates equal, 1/√6 each (1e-8: the O(√u) bar of the former
+          // classification after QZ; ModesDeflation checks it to u/gap)
           for (Eigen::Index i = 0; i < 6; ++i) EXPECT_NEAR(std::abs(md.shape[i]), 1 / std::sqrt(6.0), 1e-8);
         } else {
           EXPECT_GT(std::abs(md.lambda), 1e3);  // no spurious near-zero "finite" eigenvalue (elastic modes are above 1e3 rad/s)
@@ -285,7 +286,11 @@ TEST(Modes, NlevpSpringDashpot) {
   QuadraticEigenSolver s(10);
   s.compute(p.M, p.Q, p.K);
   EXPECT_EQ(s.rank_M(), 2);
-  EXPECT_GE(count(s, EigenvalueKind::infinite), 8);  // at least n − rank(M)
+  // n − rank(M) = 8 null vectors of M, and D = kron(diag(0, η), K₂) is nonsingular on them
+  // (Wᵀ D N regular): no Jordan chains at ∞, exactly 8 infinite eigenvalues, all semisimple.
+  EXPECT_EQ(count(s, EigenvalueKind::infinite), 8);
+  EXPECT_EQ(s.num_infinite(), 8);
+  for (const Mode& m : s.modes()) EXPECT_FALSE(m.defective);
   expect_backward_stable(p, s);
   expect_accurate(p, s, 1e-10);
 }
@@ -408,4 +413,190 @@ TEST(Modes, DegenerateCoefficients) {
     EXPECT_EQ(s.modes()[1].lambda, cd(0.0, -2.0));
     EXPECT_NEAR(s.modes()[0].natural_frequency_hz, 2.0 / (2 * M_PI), 1e-16);  // one rounding
   }
+}
+
+// ---- Exact deflation of zero and infinite eigenvalues (issue 3 §2) ----------------------------
+// Default tolerance (QuadraticEigenOptions::rank_tolerance = 0): a pivot of the column-pivoted QR
+// of Mᵀ or Kᵀ counts as zero when |R_ii| ≤ f·u·|R_00|, a pivot of the remaining linearization
+// block when ≤ 2f·u·‖A‖_F (‖B‖_F).
+
+namespace {
+
+/// Ear-scaled free-free chain (no spring or damper to ground): one rigid-body mode.
+Qep free_free_ear_chain(bool damped) {
+  const std::vector<double> m{1e-6, 2e-6, 5e-6, 1e-5, 2e-5, 3e-5};
+  const std::vector<double> k{0, 1e2, 5e2, 1e3, 5e3, 1e4, 0};
+  const std::vector<double> c{0, 1e-3, 1e-3, 5e-4, 5e-4, 1e-4, 0};
+  return testmodels::chain(m, k, damped ? c : std::vector<double>{});
+}
+
+/// Second smallest singular value of K: the gap that bounds the error of a computed null vector.
+double sigma_second_smallest(const Eigen::MatrixXd& K) {
+  const Eigen::VectorXd s = Eigen::JacobiSVD<Eigen::MatrixXd>(K).singularValues();
+  return s[s.size() - 2];
+}
+
+}  // namespace
+
+TEST(ModesDeflation, FreeFreeChainRigidBodyModeIsExactlyZero) {
+  for (bool damped : {false, true})
+    for (bool fast : {true, false}) {
+      const Qep p = free_free_ear_chain(damped);
+      QuadraticEigenOptions o;
+      o.symmetric_fast_path = fast;
+      QuadraticEigenSolver s(6, o);
+      s.compute(p.M, p.Q, p.K);
+      SCOPED_TRACE(std::string(damped ? "damped " : "undamped ") + s.method());
+      // One null vector of K and no damping on it (the dampers connect masses only): a 2×2
+      // Jordan block at 0, so exactly two zero eigenvalues, both deflated before QZ.
+      EXPECT_EQ(s.num_zero(), 2);
+      EXPECT_EQ(s.num_infinite(), 0);
+      ASSERT_EQ(count(s, EigenvalueKind::zero), 2);
+      const double sigma = sigma_second_smallest(p.K);
+      for (const Mode& m : s.modes()) {
+        if (m.kind != EigenvalueKind::zero) {
+          EXPECT_GT(std::abs(m.lambda), 1e3);  // elastic modes only (all above 1e3 rad/s)
+          continue;
+        }
+        EXPECT_EQ(m.lambda, cd(0.0));  // exactly, never 1e-4 rad/s
+        EXPECT_EQ(m.alpha, cd(0.0));
+        EXPECT_EQ(m.beta, 1.0);
+        EXPECT_TRUE(m.defective);
+        EXPECT_TRUE(std::isinf(m.condition_homogeneous));
+        // The rigid-body shape (1, …, 1)/√6 in closed form. A null vector computed from K with
+        // rounding errors of size c·f·u·‖K‖ is off by about that over the gap σ_{n−1}(K)
+        // (Wedin): c = 10 slack. (The old threshold classification only reached O(√u) = 1e-8.)
+        const double tol = 10.0 * 6 * u * p.K.norm() / sigma;
+        for (Eigen::Index i = 0; i < 6; ++i)
+          EXPECT_NEAR(m.shape[i].real(), 1 / std::sqrt(6.0), tol) << "coordinate " << i;
+        EXPECT_LE(m.shape.imag().norm(), tol);
+      }
+      expect_backward_stable(p, s);
+      expect_accurate(p, s);
+    }
+}
+
+TEST(ModesDeflation, SingularMassMasslessCoordinate) {
+  // Coordinate 3 of 5 massless. Without a damper on it the null vector e_3 of M starts a Jordan
+  // chain of length 2 at ∞ (Q e_3 = 0): two infinite eigenvalues; with a damper one.
+  for (double c3 : {0.0, 0.3}) {
+    const Qep p = testmodels::chain({1, 2, 0, 1.5, 1}, {100, 200, 300, 200, 100, 50},
+                                    {0.1, 0.2, c3, 0, 0.2, 0.1});
+    QuadraticEigenSolver s(5);
+    s.compute(p.M, p.Q, p.K);
+    SCOPED_TRACE("c3 = " + std::to_string(c3));
+    const int expected = c3 == 0.0 ? 2 : 1;
+    EXPECT_EQ(s.rank_M(), 4);
+    EXPECT_EQ(s.num_infinite(), expected);
+    EXPECT_EQ(count(s, EigenvalueKind::infinite), expected);
+    EXPECT_EQ(count(s, EigenvalueKind::finite), 10 - expected);
+    EXPECT_EQ(s.null_space_M().cols(), 1);
+    for (const Mode& m : s.modes()) {
+      if (m.kind != EigenvalueKind::infinite) continue;
+      EXPECT_TRUE(std::isinf(m.lambda.real()));
+      EXPECT_EQ(m.alpha, cd(1.0));
+      EXPECT_EQ(m.beta, 0.0);
+      EXPECT_EQ(m.defective, c3 == 0.0);
+      // M is diagonal with an exact zero: its null vector is e_3 up to the rounding of the
+      // Householder reflections of the QR (a few u).
+      EXPECT_NEAR(std::abs(m.shape[2]), 1.0, 10 * u);
+      EXPECT_EQ(m.backward_error, 0.0);  // M x = 0 exactly: residual ‖Mx‖ of a diagonal M
+    }
+    expect_backward_stable(p, s);
+    expect_accurate(p, s);
+  }
+}
+
+TEST(ModesDeflation, FreeFreeAndMasslessAtOnce) {
+  // Free-free chain (no ground spring or damper) with a massless, undamped middle coordinate:
+  // K and M both singular; 2 zero (rigid body, undamped), 2 infinite (no damper on coordinate 3)
+  // and 6 finite eigenvalues.
+  const Qep p = testmodels::chain({1, 2, 0, 1.5, 1}, {0, 200, 300, 200, 100, 0},
+                                  {0, 0.2, 0, 0, 0.2, 0});
+  QuadraticEigenSolver s(5);
+  s.compute(p.M, p.Q, p.K);
+  EXPECT_EQ(s.rank_K(), 4);
+  EXPECT_EQ(s.rank_M(), 4);
+  EXPECT_EQ(s.num_zero(), 2);
+  EXPECT_EQ(s.num_infinite(), 2);
+  EXPECT_EQ(count(s, EigenvalueKind::finite), 6);
+  expect_backward_stable(p, s);
+  expect_accurate(p, s);
+  // The same with a damper to ground on mass 1: the rigid-body mode is damped, one zero
+  // eigenvalue and a real one λ = −c/Σm (with the massless coordinate carried along).
+  const Qep q = testmodels::chain({1, 2, 0, 1.5, 1}, {0, 200, 300, 200, 100, 0},
+                                  {0.1, 0.2, 0, 0, 0.2, 0});
+  s.compute(q.M, q.Q, q.K);
+  EXPECT_EQ(s.num_zero(), 1);
+  EXPECT_EQ(s.num_infinite(), 2);
+  EXPECT_EQ(count(s, EigenvalueKind::finite), 7);
+  expect_backward_stable(q, s);
+  expect_accurate(q, s);
+}
+
+TEST(ModesDeflation, StronglyDampedFreeFreeWithMasslessCoordinateTropical) {
+  // τ ≈ 2e3: tropical scaling, with deflated zeros and an infinite eigenvalue, and a complex pair
+  // (|λ| ≈ 2e4) between the two tropical groups (|λ| ≈ 5 and 1.5e8): each finite eigenvalue must
+  // still come out backward stable (the three-run split of quadratic_eigen.cpp).
+  const Qep p = testmodels::chain({1e-6, 2e-6, 0, 1e-5}, {0, 1e2, 5e2, 1e3, 0},
+                                  {0, 100, 100, 0, 0});
+  QuadraticEigenSolver s(4);
+  s.compute(p.M, p.Q, p.K);
+  EXPECT_EQ(s.method(), "tropical");
+  EXPECT_EQ(s.num_zero(), 2);
+  EXPECT_EQ(s.num_infinite(), 1);
+  EXPECT_EQ(count(s, EigenvalueKind::finite), 5);
+  expect_backward_stable(p, s);
+  expect_accurate(p, s);
+}
+
+TEST(ModesDeflation, NearZeroEigenvalueIsNotDeflated) {
+  // Free-free chain with a weak damper to ground c0 = 1e-7 N·s/m on mass 1: K is singular (one
+  // rigid-body null vector) but the damping on it is not zero, so λ = 0 is simple and the second
+  // eigenvalue of the rigid-body motion is the small real λ ≈ −c0/Σm ≈ −1.7e-8/s, i.e.
+  // |λ|/γ ≈ 1e-9. The pivot that would continue the Jordan chain is of the size of the scaled
+  // c0 (≈ 1e-9 relative), far above the stated 2f·u·‖A‖_F ≈ 1e-15, so it is not deflated: it
+  // must be reported finite and accurate. (The former classification, |λ|/γ ≤ 1e-6 with up to
+  // two per null vector of K, reported it as a second zero.)
+  const Qep p = testmodels::chain({1, 2, 3}, {0, 200, 300, 0}, {1e-7, 0.2, 0.1, 0});
+  QuadraticEigenSolver s(3);
+  s.compute(p.M, p.Q, p.K);
+  EXPECT_EQ(s.rank_K(), 2);
+  EXPECT_EQ(s.num_zero(), 1);
+  ASSERT_EQ(count(s, EigenvalueKind::finite), 5);
+  const Mode& slow = s.modes()[1];  // sorted: the zero, then the smallest finite
+  ASSERT_EQ(slow.kind, EigenvalueKind::finite);
+  EXPECT_LT(std::abs(slow.lambda) / s.gamma(), 1e-6);
+  const cd ref = hp::refine_eigenvalue(p.M, p.Q, p.K, slow.lambda, slow.shape);
+  // Normwise this eigenvalue is ill-conditioned (κ ≈ 1e18: the normwise bound κ·η is vacuous).
+  // Deflation keeps the null vector v = (1,1,1)/√3 of K exact, so λ ≈ −(vᵀQv)/(vᵀMv) depends on
+  // the damping of the rigid-body motion only, vᵀQv = c0/3, which a backward error η ≤ bar
+  // changes by at most bar·‖Q‖: relative error ≤ 3·bar·‖Q‖_F/c0 ≈ 4e-7 (measured 2e-10).
+  EXPECT_LE(std::abs(slow.lambda - ref) / std::abs(ref), 3.0 * backward_bar(3) * p.Q.norm() / 1e-7);
+  EXPECT_EQ(slow.lambda.imag(), 0.0);
+  // −c0/Σm to first order in c0 (the next term is O(c0²/(Σm·c_internal)) ≈ 1e-6 relative).
+  EXPECT_NEAR(ref.real(), -1e-7 / 6.0, 1e-5 * 1e-7 / 6.0);
+  expect_backward_stable(p, s);
+
+  // A weak spring to ground (k0 = 1e-9 N/m) instead: K is regular at the stated tolerance
+  // (σ_min/‖K‖ ≈ 1e-12 ≫ f·u), nothing is deflated, and ω ≈ √(k0/Σm) ≈ 1.3e-5 rad/s is finite.
+  const Qep q = testmodels::chain({1, 2, 3}, {1e-9, 200, 300, 0}, {0, 0.2, 0.1, 0});
+  s.compute(q.M, q.Q, q.K);
+  EXPECT_EQ(s.rank_K(), 3);
+  EXPECT_EQ(s.num_zero(), 0);
+  EXPECT_EQ(count(s, EigenvalueKind::finite), 6);
+  // √(k0/Σm) is first order in k0/k ≈ 5e-12; the computed ω is normwise ill-conditioned
+  // (κ ≈ 1e12, η ≈ 1e-16: about 1e-4 relative, measured 1.8e-5), hence 1e-3.
+  EXPECT_NEAR(std::abs(s.modes()[0].lambda), std::sqrt(1e-9 / 6.0), 1e-3 * std::sqrt(1e-9 / 6.0));
+  expect_backward_stable(q, s);
+  expect_accurate(q, s);
+}
+
+TEST(ModesDeflation, CommonNullVectorIsASingularProblem) {
+  // Coordinate 3 has no mass, damping or stiffness: det(λ²M + λQ + K) ≡ 0.
+  Eigen::MatrixXd M = Eigen::MatrixXd::Identity(3, 3), K = 2.0 * Eigen::MatrixXd::Identity(3, 3);
+  M(2, 2) = 0.0;
+  K(2, 2) = 0.0;
+  QuadraticEigenSolver s(3);
+  EXPECT_THROW(s.compute(M, Eigen::MatrixXd::Zero(3, 3), K), mbsgen::SingularSystemError);
 }

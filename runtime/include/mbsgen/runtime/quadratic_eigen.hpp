@@ -25,8 +25,9 @@ const char* to_string(EigenvalueKind kind);
 struct Mode {
   /// Reported eigenvalue λ (1/s): exactly 0 for kind zero, +∞ (real part) for kind infinite.
   std::complex<double> lambda;
-  /// The computed homogeneous pair (α, β) with λ = α/β, unscaled, normalized |α|²+β² = 1, β ≥ 0.
-  /// Kept as computed, also for zero and infinite eigenvalues.
+  /// The homogeneous pair (α, β) with λ = α/β, unscaled, normalized |α|²+β² = 1, β ≥ 0: as
+  /// computed by QZ for finite eigenvalues; exactly (0, 1) for kind zero and (1, 0) for kind
+  /// infinite, which are deflated before QZ and never computed as numbers.
   std::complex<double> alpha;
   double beta = 0.0;
   EigenvalueKind kind = EigenvalueKind::finite;
@@ -48,6 +49,10 @@ struct Mode {
   /// Homogeneous (chordal) condition number of (α, β) (Dedieu & Tisseur 2003), finite also for
   /// zero and infinite eigenvalues.
   double condition_homogeneous = 0.0;
+  /// True for a zero or infinite eigenvalue in a Jordan chain (algebraic multiplicity above the
+  /// geometric one, e.g. the double λ = 0 of an undamped rigid-body mode): it has one eigenvector
+  /// per chain, `shape` is that eigenvector (the chain's head), and both condition numbers are +∞.
+  bool defective = false;
 };
 
 /// Options of QuadraticEigenSolver.
@@ -61,13 +66,19 @@ struct QuadraticEigenOptions {
   Scaling scaling = Scaling::automatic;
   bool balance = true;               ///< LAPACK dggevx balancing (permute and scale), 'B'
   bool symmetric_fast_path = true;   ///< dsygvd when Q = 0, M = Mᵀ > 0, K = Kᵀ
-  /// Rank tolerance: a pivot |R_ii| ≤ rank_tolerance·|R_00| of the column-pivoted QR of M (or K)
-  /// counts as zero. 0 means the default f·u (u = 2⁻⁵³).
+  /// Rank tolerance tol of the deflation of zero and infinite eigenvalues; 0 means the default
+  /// f·u (u = 2⁻⁵³). Two kinds of rank decision use it:
+  ///  - M and K: a pivot |R_ii| ≤ tol·|R_00| of the column-pivoted QR (LAPACK dgeqp3) of Mᵀ
+  ///    (Kᵀ) counts as zero; its null vectors are the eigenvectors of the f − rank(M) infinite
+  ///    (f − rank(K) zero) eigenvalues deflated first, so their backward error is ≤ ‖R₂₂‖/‖M‖;
+  ///  - further members of Jordan chains at 0 or ∞ (e.g. a rigid-body mode without damping, a
+  ///    massless coordinate without a damper, constraints): a pivot ≤ 2·tol·‖A‖_F (‖B‖_F) of the
+  ///    column-pivoted QR of the remaining block of the scaled linearization A − μB.
+  /// An eigenvalue is deflated only if a perturbation of that relative size makes it exactly 0 or
+  /// ∞: a small but nonzero eigenvalue (a soft spring, a weak damper to ground) stays finite.
   double rank_tolerance = 0.0;
-  /// Classification tolerance: when M has numerical nullity d, up to 2d eigenvalues with
-  /// |λ| ≥ γ/classification_tolerance are reported infinite; when K has nullity d, up to 2d with
-  /// |λ| ≤ γ·classification_tolerance are reported zero (γ = √(‖K‖/‖M‖)). The default 1e-6
-  /// separates the O(√u) perturbation of a 2×2 Jordan block at 0 or ∞ from physical modes.
+  /// Unused since zero and infinite eigenvalues are deflated exactly (see rank_tolerance); kept so
+  /// that code setting it still compiles.
   double classification_tolerance = 1e-6;
   /// Report each complex-conjugate pair once (the member with Im λ > 0), and a double zero
   /// eigenvalue of a rigid-body mode once.
@@ -78,10 +89,18 @@ struct QuadraticEigenOptions {
 ///
 /// General path: the first companion linearization
 ///     μ [[E, 0], [0, M̃]] − [[0, E], [−K̃, −Q̃]],   z = [x; μx],
-/// of the scaled problem M̃ = γ²δM, Q̃ = γδQ, K̃ = δK, λ = γμ, solved by LAPACK dggevx with
-/// balancing; x is taken from the block of z that gives the smaller backward error (as in
-/// quadeig, Hammarling, Munro & Tisseur 2013). The symmetric undamped fast path uses dsygvd
-/// (Cholesky of M inside LAPACK; M⁻¹ is never formed). Cost: O(f³), about 10·(2f)³ flops for QZ.
+/// of the scaled problem M̃ = γ²δM, Q̃ = γδQ, K̃ = δK, λ = γμ. When M or K is rank deficient
+/// (QuadraticEigenOptions::rank_tolerance) the zero and infinite eigenvalues are first deflated
+/// exactly, as quadeig does (Hammarling, Munro & Tisseur 2013, §4-5): orthogonal transformations
+/// split off a triangular pencil whose eigenvalues are exactly 0 and ∞ — one per null vector of K
+/// (M), then, by a staircase of rank-revealing QRs (Van Dooren 1979), the further members of
+/// Jordan chains — and the remaining pencil, whose eigenvalues are all finite and nonzero, is
+/// solved by LAPACK dggevx with balancing. x is taken from the block of z that gives the smaller
+/// backward error (as in quadeig). The symmetric undamped fast path uses dsygvd (Cholesky of M
+/// inside LAPACK; M⁻¹ is never formed), on the M-orthogonal complement of the null space of K
+/// when K is singular. Throws SingularSystemError when det(λ²M + λQ + K) vanishes identically.
+/// Cost: O(f³), about 10·(2f)³ flops for QZ; the deflation adds O(f³) only when M or K is
+/// singular.
 class QuadraticEigenSolver {
  public:
   /// Preallocates for f coordinates.
@@ -101,6 +120,15 @@ class QuadraticEigenSolver {
 
   Eigen::Index rank_M() const { return rank_M_; }  ///< numerical rank of M
   Eigen::Index rank_K() const { return rank_K_; }  ///< numerical rank of K
+  /// Number of eigenvalues deflated as exactly zero (algebraic multiplicity of λ = 0; each
+  /// counts once in modes() even when one_per_conjugate_pair lists a Jordan chain once).
+  Eigen::Index num_zero() const { return num_zero_; }
+  /// Number of eigenvalues deflated as infinite (algebraic multiplicity of λ = ∞).
+  Eigen::Index num_infinite() const { return num_infinite_; }
+  /// f×(f − rank K) orthonormal basis of the numerical null space of K (rigid-body modes).
+  const Eigen::MatrixXd& null_space_K() const { return null_K_; }
+  /// f×(f − rank M) orthonormal basis of the numerical null space of M (massless coordinates).
+  const Eigen::MatrixXd& null_space_M() const { return null_M_; }
   double tau() const { return tau_; }              ///< ‖Q‖/√(‖M‖‖K‖) (Frobenius norms)
   double gamma() const { return gamma_; }          ///< eigenvalue scaling γ (1/s)
   /// "symmetric", "fan_lin_van_dooren", "tropical" or "none": what compute() used.
@@ -117,7 +145,8 @@ class QuadraticEigenSolver {
   QuadraticEigenOptions options_;
   Eigen::ComputationInfo info_ = Eigen::InvalidInput;
   std::vector<Mode> modes_;
-  Eigen::Index rank_M_ = 0, rank_K_ = 0;
+  Eigen::Index rank_M_ = 0, rank_K_ = 0, num_zero_ = 0, num_infinite_ = 0;
+  Eigen::MatrixXd null_M_, null_K_;
   double tau_ = 0.0, gamma_ = 1.0;
   double norm_M_ = 0.0, norm_Q_ = 0.0, norm_K_ = 0.0;  // ‖·‖₂ lower estimates
   std::string method_;
