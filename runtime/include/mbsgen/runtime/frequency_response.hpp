@@ -30,8 +30,8 @@ const char* to_string(FrfMethod method);
 FrfMethod parse_frf_method(const std::string& name);
 
 /// The method FrfMethod::automatic uses for `model` (f coordinates, half-bandwidth b) and a call
-/// with `frequencies` frequencies (docs/accuracy-vs-time.md §5): direct when f < 12; banded when
-/// 4b ≤ f and b² ≤ 16f; hessenberg when frequencies ≥ min(30, max(8, f/2)) and
+/// with `frequencies` frequencies (docs/accuracy-vs-time.md §5): banded when 4b ≤ f and
+/// b² ≤ 16f; otherwise direct when f < 12; hessenberg when frequencies ≥ min(30, max(8, f/2)) and
 /// rcond₁(M̃)·rcond₁(K̃) ≥ 1e-8, with M̃, K̃ = S M S, S K S and S = diag(M)^(−1/2) (M or K
 /// singular fails the test); otherwise direct. Costs two LU factorizations of f×f matrices when
 /// it gets to the conditioning test, nothing otherwise.
