@@ -61,8 +61,7 @@ Timing time_calls(F&& call, int repetitions, double min_batch_s = 0.05, double l
   return t;
 }
 
-/// A CSV file with a fixed header; fields are written as given (no quoting: none of ours holds a
-/// comma).
+/// A CSV file with a fixed header; a field holding a comma or a quote is quoted (RFC 4180).
 class Csv {
  public:
   Csv(const std::string& path, const std::string& header) : f_(std::fopen(path.c_str(), "w")) {
@@ -75,7 +74,15 @@ class Csv {
   Csv& operator=(const Csv&) = delete;
   bool ok() const { return f_ != nullptr; }
   void row(const std::vector<std::string>& fields) {
-    for (std::size_t i = 0; i < fields.size(); ++i) std::fprintf(f_, "%s%s", i ? "," : "", fields[i].c_str());
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      std::string v = fields[i];
+      if (v.find_first_of(",\"\n") != std::string::npos) {
+        std::string q = "\"";
+        for (char c : v) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+        v = q + "\"";
+      }
+      std::fprintf(f_, "%s%s", i ? "," : "", v.c_str());
+    }
     std::fprintf(f_, "\n");
     std::fflush(f_);
   }

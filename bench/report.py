@@ -108,7 +108,7 @@ IMG_REL = os.path.relpath(IMAGES, os.path.dirname(os.path.abspath(OUTPUT)) or ".
 
 def gnuplot(name, body, size=(760, 500)):
     """Runs a gnuplot script body twice (SVG and PNG) into IMAGES/name.{svg,png}."""
-    script = os.path.join(PLOT_WORK, name + ".gp")
+    script = os.path.abspath(os.path.join(PLOT_WORK, name + ".gp"))
     with open(script, "w") as f:
         for term, ext, extra in (("svg", "svg", " dynamic background rgb 'white'"), ("pngcairo", "png", "")):
             f.write("set terminal %s size %d,%d font 'sans,11'%s\n" % (term, size[0], size[1], extra))
@@ -237,9 +237,18 @@ w("")
 w("**Noise.** The machine has %s cores shared with other jobs (load averages above); the figures are "
   "medians of repetitions, but repeated runs still differ by tens of per cent. Read ratios measured in "
   "the same run, not digits. All BLAS/LAPACK calls, ours and Octave's, run single-threaded "
-  "(`OPENBLAS_NUM_THREADS=1`): on this shared machine OpenBLAS's threads made small solves several "
-  "times slower." % system.get("nproc", "?"))
+  "(`OPENBLAS_NUM_THREADS=1`); with OpenBLAS's default threads small problems are slower on this shared "
+  "machine (the middle ear, time per frequency at F = %d):" % (system.get("nproc", "?"), F_REPORT))
 w("")
+threads = {r["method"]: r for r in read_csv(os.path.join("threads", "frf.csv"))}
+rows = []
+for m in ("direct", "hessenberg", "modal_all", "direct_float"):
+    if m in threads and ok("middle_ear", m):
+        a, b = val("middle_ear", m, "amortized_s"), num(threads[m]["amortized_s"])
+        rows.append([m, ftime(a), ftime(b), fratio(b, a)])
+if rows:
+    w(table(["method", "1 thread", "OpenBLAS default threads", "ratio"], rows))
+    w("")
 w("## 1. How it is measured")
 w("")
 w("- **Harness** (`bench/harness.hpp`): each measurement is the median of 5 repetitions (3 with `--quick`; "
@@ -341,20 +350,25 @@ for p in main_problems:
             fam[3].append((t, e, "octave " + r["method"].split("_")[0]))
             pts.append((t, e))
     if pts:
+        # Labels alternate above and below their points (by increasing time) to overlap less.
+        order = sorted((t, k, i) for k, v in fam.items() for i, (t, e, _) in enumerate(v))
+        shift = {(k, i): (3.0 if j % 2 == 0 else 1 / 4.0) for j, (_, k, i) in enumerate(order)}
+        for k in fam:
+            fam[k] = [(t, e, name, t * 1.06, e * shift[(k, i)]) for i, (t, e, name) in enumerate(fam[k])]
         files = [write_data("frf_%s_%d.dat" % (p, k), v) if v else None for k, v in fam.items()]
-        front = write_data("frf_%s_front.dat" % p, pareto_front(pts))
+        front = write_data("frf_%s_front.dat" % p, pareto_front([(t, e) for t, e in pts if e < 0.1]))
         colours = ["#1f77b4", "#2ca02c", "#ff7f0e", "#d62728"]
         names = ["mbsgen", "mbsgen modal", "single precision", "Octave"]
-        plots = ["'%s' using 1:2 with lines lc rgb '#bbbbbb' lw 2 title 'Pareto front'" % front]
+        plots = ["'%s' using 1:2 with lines lc rgb '#bbbbbb' lw 2 title 'Pareto front (error < 0.1)'" % front]
         for k, f in enumerate(files):
             if f:
                 plots.append("'%s' using 1:2 with points pt 7 ps 1.2 lc rgb '%s' title '%s'" % (f, colours[k], names[k]))
-                plots.append("'%s' using 1:2:3 with labels offset char 0.6,0.6 left font ',9' tc rgb '%s' notitle"
+                plots.append("'%s' using 4:5:3 with labels left font ',9' tc rgb '%s' noenhanced notitle"
                              % (f, colours[k]))
         body = ("set logscale xy\nset grid\nset key bottom right box opaque\n"
                 "set xlabel 'time per frequency at F = %d [s]'\nset ylabel 'largest relative error'\n"
                 "set format x '10^{%%L}'\nset format y '10^{%%L}'\nset yrange [1e-17:100]\n"
-                "set title \"%s\"\nset offsets graph 0.05, graph 0.25, 0, 0\nplot %s"
+                "set title \"%s\" noenhanced\nset offsets graph 0.05, graph 0.25, 0, 0\nplot %s"
                 % (F_REPORT, label[p].replace('"', "'"), ", ".join(plots)))
         w(gnuplot("frf_" + p, body))
         w("")
@@ -387,7 +401,7 @@ if chains:
         data = [(size[p], val(p, m, "amortized_s")) for p in chains if ok(p, m)]
         if data:
             series.append("'%s' using 1:2 with linespoints pt 7 lc rgb '%s' title '%s'"
-                          % (write_data("chain_%s.dat" % m, data), colours[m], m))
+                          % (write_data("chain_%s.dat" % m, data), colours[m], m.replace("_", " ")))
     data = [(size[p], num(r["amortized_s"])) for p in chains for r in octave.get(p, []) if r["method"] == "freqresp"
             and math.isfinite(num(r["amortized_s"]))]
     if data:
@@ -521,8 +535,8 @@ w("Four variants of the generator on the N-link chains: the structure-aware proj
   "one (M = Σ J̄ᵀĪJ̄ and k − q = Σ J̄ᵀf̄ body by body, `Projection::naive`, `generator/dynamics.hpp`), each with "
   "and without CSE (`EmitOptions::cse`). The two projections give the same matrices "
   "(`tests/generator/naive_projection_test.cpp`: exactly for small chains, to 40 digits for the tree models); "
-  "here the `linear` kernels of all four agree to the last column. Generation = derive + linearize + "
-  "emit, in process; ops = operations (+, −, ×, ÷, calls) of the emitted `linear` kernel (M, Q, K, B, C); "
+  "here the `linear` kernels of all four agree to rounding (last column). Generation = derive + "
+  "linearize + emit, in process; ops = operations (+, −, ×, ÷, calls) of the emitted `linear` kernel (M, Q, K, B, C); "
   "compile = the whole emitted file, `-O2`; kernel = one call of `linear`.")
 w("")
 sympy = {}
@@ -577,9 +591,10 @@ if sympy:
         rows.append([str(N), status, ftime(num(kv.get("derive_s"))), ftime(num(kv.get("linearize_s"))),
                      kv.get("ops_mass_forcing", "–"), kv.get("ops_linear", "–"), kv.get("ops_linear_cse", "–"),
                      ferr(num(kv.get("max_rel_diff"))), limit + " s"])
-    w("SymPy in detail (`bench/peers/sympy_chain.py`: `kanes_equations`, then `linearize(A_and_B=False)` — "
-      "no symbolic inversion of M — and `sympy.cse` of the linear matrices; the last column compares its M, C, "
-      "K at q = 0 with ours):")
+    w("SymPy in detail (`bench/peers/sympy_chain.py`: `kanes_equations`, then `linearize(A_and_B=False)` at "
+      "rest about any q — like our `linear` kernel, whose operating point is an argument; no symbolic "
+      "inversion of M — and `sympy.cse` of the linear matrices; operations by `count_ops`, ours as emitted; "
+      "the last column compares its M, C, K at q = 0 with ours):")
     w("")
     w(table(["N", "status", "derive", "linearize", "ops of M and forcing", "ops of linear M, A",
              "after cse", "max rel. diff. to mbsgen", "time limit"], rows))
@@ -619,41 +634,124 @@ w("The recommendation per regime, from the measurements above. The runtime's `au
   "(`automatic_frf_method`, runtime/src/frequency_response.cpp) implements the frequency-response rows "
   "marked **auto**; `tests/runtime/test_auto_method.cpp` checks one case per row.")
 w("")
-w(table(["regime", "recommended", "why (this run's figures in the sections above)"], [
-    ["any f < 12 coordinates", "**auto → direct**",
-     "every method costs microseconds per frequency; direct is backward stable and the most accurate "
-     "(the rotor: direct's error is 1000× below hessenberg's)"],
+
+
+def rng(values, f):
+    values = [v for v in values if math.isfinite(v)]
+    if not values:
+        return "–"
+    lo, hi = min(values), max(values)
+    return f(lo) if f(lo) == f(hi) else "%s–%s" % (f(lo), f(hi))
+
+
+def times(a, b):
+    return fratio(a, b) if math.isfinite(a) and math.isfinite(b) else "–"
+
+
+big = chains[-1] if chains else None
+wide = max(sweep, key=lambda p: bandwidth[p]) if sweep else None
+dense_mid = "middle_ear" if ("middle_ear", "direct") in by else None
+ev = {}
+ev["rotor"] = ("hessenberg %s faster, error %s against direct's %s"
+               % (times(val("rotor", "direct", "amortized_s"), val("rotor", "hessenberg", "amortized_s")),
+                  ferr(val("rotor", "hessenberg", "err_max")), ferr(val("rotor", "direct", "err_max")))
+               if ok("rotor", "hessenberg") else "–")
+ev["banded"] = ("n = %d: banded %s faster than direct, %s faster than hessenberg, error %s"
+                % (size[big], times(val(big, "direct", "amortized_s"), val(big, "banded", "amortized_s")),
+                   times(val(big, "hessenberg", "amortized_s"), val(big, "banded", "amortized_s")),
+                   ferr(val(big, "banded", "err_max"))) if big and ok(big, "banded") else "–")
+if wide:
+    ev["banded"] += "; sweep b = %d (= n/4): banded %s the time of hessenberg" % (
+        bandwidth[wide], times(val(wide, "banded", "amortized_s"), val(wide, "hessenberg", "amortized_s")))
+ev["hess"] = ("middle ear at F = %d: %s faster than direct, error %s (direct %s)"
+              % (F_REPORT, times(val("middle_ear", "direct", "amortized_s"), val("middle_ear", "hessenberg", "amortized_s")),
+                 ferr(val("middle_ear", "hessenberg", "err_max")), ferr(val("middle_ear", "direct", "err_max")))
+              if dense_mid else "–")
+if big and ok(big, "hessenberg"):
+    ev["hess"] += "; chain n = %d treated as dense: %s faster than direct, error %s" % (
+        size[big], times(val(big, "direct", "amortized_s"), val(big, "hessenberg", "amortized_s")),
+        ferr(val(big, "hessenberg", "err_max")))
+ev["cond"] = ("speaker_box: hessenberg %s, direct %s" % (ferr(val("speaker_box", "hessenberg", "err_max")),
+                                                       ferr(val("speaker_box", "direct", "err_max")))
+              if ok("speaker_box", "hessenberg") else "–")
+modal_err = ", ".join("n = %d: %s" % (size[p], ferr(val(p, "modal_all", "err_max"), int(by[(p, "modal_all")]["flagged"])))
+                      for p in chains if ok(p, "modal_all"))
+ev["modal"] = ("middle ear at F = 1000: modal %s, hessenberg %s (setup + 1000 × per frequency); chain: %s"
+               % (ftime(cost("middle_ear", "modal_all", 1000)), ftime(cost("middle_ear", "hessenberg", 1000)), modal_err)
+               if dense_mid and ok("middle_ear", "modal_all") else modal_err or "–")
+inband_sc = [val(p, m, "err_in_band") for p in main_problems for m in ("modal_half", "modal_quarter") if ok(p, m)]
+inband_nosc = [val(p, m, "err_in_band") for p in main_problems for m in ("modal_half_nosc", "modal_quarter_nosc") if ok(p, m)]
+whole = [val(p, m, "err_max") for p in main_problems for m in ("modal_half", "modal_quarter", "modal_half_nosc",
+                                                               "modal_quarter_nosc") if ok(p, m)]
+ev["trunc"] = ("in band: %s with static correction, %s without; over the whole band: %s"
+               % (rng(inband_sc, ferr), rng(inband_nosc, ferr), rng(whole, ferr)))
+ev["real"] = ("time %s of direct's; errors %s (direct %s)"
+              % (rng([val(p, "real", "amortized_s") / val(p, "direct", "amortized_s") for p in main_problems if ok(p, "real")],
+                     lambda x: "%.2g×" % x),
+                 rng([val(p, "real", "err_max") for p in main_problems if ok(p, "real")], ferr),
+                 rng([val(p, "direct", "err_max") for p in main_problems if ok(p, "real")], ferr)))
+ev["float"] = ("direct in float: %s of direct's time, errors %s; banded in float: %s of banded's time"
+               % (rng([val(p, "direct_float", "amortized_s") / val(p, "direct", "amortized_s") for p in main_problems
+                       if ok(p, "direct_float")], lambda x: "%.2g×" % x),
+                  rng([val(p, "direct_float", "err_max") for p in main_problems if ok(p, "direct_float")], ferr),
+                  rng([val(p, "banded_float", "amortized_s") / val(p, "banded", "amortized_s") for p in main_problems
+                       if ok(p, "banded_float") and ok(p, "banded")], lambda x: "%.2g×" % x)))
+qz_sym = [num(mby[(p, "qz")]["time_s"]) / num(mby[(p, "symmetric")]["time_s"]) for p in mprobs if (p, "qz") in mby]
+sym_part = [(int(mby[(p, "symmetric")]["n"]), num(mby[(p, "symmetric")]["time_s"]) / num(mby[(p, "partial")]["time_s"]),
+             num(mby[(p, "partial")]["err_lowest_k"]), num(mby[(p, "symmetric")]["err_lowest_k"])) for p in mprobs]
+ev["modes"] = "full QZ %s the time of the symmetric path" % rng(qz_sym, lambda x: "%.2g×" % x)
+if sym_part:
+    nmax, r_, ep, es = max(sym_part)
+    ev["modes"] += ("; at n = %d the partial spectrum (k = 20) is %s faster than all modes, lowest-mode error %s "
+                    "against %s" % (nmax, "%.2g×" % r_, ferr(ep), ferr(es)))
+gp = [r for r in gen if r["chain"] == "planar"]
+ev["gen"] = "–"
+if gp:
+    Nmax = max(int(r["N"]) for r in gp)
+    g = {r["variant"]: r for r in gp if int(r["N"]) == Nmax}
+    if "composite_cse" in g and "naive_cse" in g:
+        ev["gen"] = ("planar N = %d: the naive projection has %s the operations, %s the generation time, %s the "
+                     "kernel time; without CSE %s the operations"
+                     % (Nmax, times(num(g["naive_cse"]["ops_linear"]), num(g["composite_cse"]["ops_linear"])),
+                        times(num(g["naive_cse"]["generation_s"]), num(g["composite_cse"]["generation_s"])),
+                        times(num(g["naive_cse"]["kernel_s"]), num(g["composite_cse"]["kernel_s"])),
+                        times(num(g["composite_nocse"]["ops_linear"]), num(g["composite_cse"]["ops_linear"]))))
+    done = [N for N, v in sympy.items() if v[0] == "done"]
+    if done:
+        Ns = max(done)
+        kv = sympy[Ns][1]
+        base = gby.get(("planar", Ns, "composite_cse"))
+        if base:
+            ev["gen"] += ("; SymPy at N = %d: %s (derive + linearize), %s mbsgen's generation"
+                          % (Ns, ftime(num(kv["derive_s"]) + num(kv["linearize_s"])),
+                             times(num(kv["derive_s"]) + num(kv["linearize_s"]), num(base["generation_s"]))))
+        stopped = [N for N, v in sympy.items() if v[0] == "timeout"]
+        if stopped:
+            ev["gen"] += ", and it did not finish N = %d within %s s" % (min(stopped), sympy[min(stopped)][2])
+
+w(table(["regime", "recommended", "evidence (this run)"], [
     ["narrow band: 4b ≤ f and b² ≤ 16f (chains, lumped FE models), any number of frequencies",
-     "**auto → banded**", "the fastest at every chain size and in the sweep up to b = n/4 at n = 200, as "
-                         "accurate as direct, no setup"],
+     "**auto → banded**", ev["banded"]],
+    ["dense and f < 12", "**auto → direct**",
+     "microseconds per frequency whatever the method; direct is backward stable: " + ev["rotor"]],
     ["dense, fewer than min(30, max(8, f/2)) frequencies", "**auto → direct**",
-     "hessenberg's one-time reduction is not paid back (break-even table)"],
-    ["dense, more frequencies, rcond(M̃)·rcond(K̃) ≥ 1e-8 (M̃, K̃ scaled to unit mass diagonal)",
-     "**auto → hessenberg**", "O(f²) per frequency after an O(f³) reduction; within 1e-12 of the reference"],
-    ["dense, badly conditioned first-order form (rcond(M̃)·rcond(K̃) < 1e-8, e.g. speaker_box), or M "
-     "or K singular", "**auto → direct**",
-     "hessenberg's error grows like u·κ(M̃)κ(K̃): speaker_box loses two more digits than direct"],
-    ["accuracy wanted near the rounding level (errors ≤ 1e-14), gyroscopic or far-apart coefficient norms",
-     "direct or banded (explicit)", "hessenberg stays within 1e-10 but loses 1–3 digits against direct on the "
-                                    "rotor and cd_player-like problems"],
-    ["very many frequencies (thousands), modes wanted anyway, well-conditioned eigenvectors (κ < 1e6)",
-     "modal with all modes (explicit)", "cheapest per frequency once the eigen-solution is paid; but its "
-                                        "error follows the eigenvector condition (chain n = 100: 1e-10; "
-                                        "n = 300: refused/wrong) — never automatic"],
-    ["a band well below the highest modes, engineering accuracy (1e-2–1e-4)",
-     "modal, truncated, with static correction (explicit)",
-     "only below about a fifth of the first neglected mode; outside it errors are O(1), with or without "
-     "the correction"],
-    ["—", "real, single precision: not recommended",
-     "real is slower than direct and squares the condition number (middle ear: flagged points); float is "
-     "no faster than double here for small n, and loses 5–9 digits"],
-    ["modes of an undamped symmetric model", "symmetric fast path (the runtime does it automatically); "
-                                             "a partial spectrum when only the lowest modes are wanted",
-     "QZ/symmetric and symmetric/partial ratios in section 3; the partial spectrum is also the most "
-     "accurate for the lowest modes"],
-    ["generation", "composite projection + CSE (the defaults)",
-     "fewest operations and fastest kernels; the naive projection's cost grows faster with N; SymPy "
-     "stops finishing within its limit at N = 10"],
+     "the Hessenberg reduction is not paid back (break-even table above)"],
+    ["dense, more frequencies, rcond(M̃)·rcond(K̃) ≥ 1e-8 (M̃, K̃: M and K scaled to unit mass diagonal)",
+     "**auto → hessenberg**", ev["hess"]],
+    ["dense, badly conditioned first-order form (rcond(M̃)·rcond(K̃) < 1e-8), or M or K singular",
+     "**auto → direct**", "hessenberg's error grows like u·κ(M̃)κ(K̃): " + ev["cond"]],
+    ["accuracy wanted near the rounding level (≤ 1e-14)", "direct or banded (explicit `--method`)",
+     "hessenberg keeps 1e-10 but loses up to three digits against direct (rotor, speaker_box, the chains)"],
+    ["thousands of frequencies, all modes wanted anyway, well-conditioned eigenvectors",
+     "modal, all modes (explicit)", ev["modal"] + " — its error follows the eigenvector condition, known "
+                                                 "only after the eigen-solution: never automatic"],
+    ["a band well below the highest modes, engineering accuracy", "modal, truncated, with static correction "
+                                                                  "(explicit)", ev["trunc"]],
+    ["—", "real: not recommended", ev["real"] + " (it squares the condition number)"],
+    ["—", "single precision: not offered", ev["float"] + "; banded in double is faster still where it applies"],
+    ["modes of an undamped symmetric model", "the symmetric path (automatic in the runtime); a partial "
+                                             "spectrum when only the lowest modes are wanted", ev["modes"]],
+    ["generation", "composite projection + CSE (the defaults)", ev["gen"]],
 ]))
 w("")
 # the data check of auto

@@ -68,9 +68,13 @@ export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 ver() { dpkg-query -W -f='${Version}' "$1" 2>/dev/null || echo "?"; }
 {
   echo "date: $(date -u '+%Y-%m-%d %H:%M UTC')"
-  echo "commit: $(git rev-parse --short HEAD 2>/dev/null || echo '?')$(git diff --quiet HEAD 2>/dev/null || echo ' (with uncommitted changes)')"
+  if [ -n "${MBSGEN_BENCH_COMMIT:-}" ]; then  # e.g. when run on an exported snapshot of a commit
+    echo "commit: $MBSGEN_BENCH_COMMIT"
+  else
+    echo "commit: $(git rev-parse --short HEAD 2>/dev/null || echo '?')$(git diff --quiet HEAD 2>/dev/null || echo ' (with uncommitted changes)')"
+  fi
   echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')"
-  echo "nproc: $(nproc)"
+  echo "nproc: $(env -u OMP_NUM_THREADS nproc)"
   echo "load_start: $(cut -d' ' -f1-3 /proc/loadavg)"
   echo "compiler: $(c++ --version | head -1)"
   echo "openblas: $(ver libopenblas0-pthread) (OPENBLAS_NUM_THREADS=1)"
@@ -93,6 +97,9 @@ q=()
 # ---- ours ---------------------------------------------------------------------------------------
 log "frequency responses (frf_accuracy ${q[*]:-})"
 "$build/bench/frf_accuracy" "$out" "${q[@]}" 2>"$out/frf.log"
+log "the same with OpenBLAS's default threads (middle ear only)"
+env -u OPENBLAS_NUM_THREADS -u OMP_NUM_THREADS "$build/bench/frf_accuracy" "$out/threads" --only middle_ear --reps 3 \
+  2>"$out/threads.log"
 log "modes (modes_accuracy ${q[*]:-})"
 "$build/bench/modes_accuracy" "$out" "${q[@]}" 2>"$out/modes.log"
 log "generation (generation_cost ${q[*]:-})"

@@ -5,7 +5,8 @@ Builds the N-link planar chain of mbsgen::planar_chain (generator/src/chain.cpp)
 sympy.physics.mechanics.KanesMethod — point masses m_i at the ends of massless rods l_i,
 revolute joints about z with relative angles q_i (q_1 from the downward vertical), a torsional
 spring k_i and damper c_i on each relative angle, gravity g along -y — derives the equations of
-motion (kanes_equations), linearizes them about q = 0, u = 0 (KanesMethod.linearize with
+motion (kanes_equations), linearizes them at rest about any q (u = 0, q symbolic, like mbsgen's
+`linear` kernel, whose operating point y0 is an argument; KanesMethod.linearize with
 A_and_B=False, i.e. without inverting M symbolically) and prints, as it goes, one "key value"
 line per result so that a run stopped by a time limit still reports what it finished:
 
@@ -89,7 +90,9 @@ def main():
     say("derive_s", "%.4g" % (time.perf_counter() - t0))
     say("ops_mass_forcing", ops(km.mass_matrix) + ops(km.forcing))
     t0 = time.perf_counter()
-    op = {**{qi: 0 for qi in q}, **{ui: 0 for ui in u}}
+    # At rest (u = 0) but about any q, as mbsgen's `linear` kernel, which takes the operating
+    # point y0 as an argument (q = 0 substituted here would fold sin and cos into constants).
+    op = {ui: 0 for ui in u}
     Ml, Al, _, _ = km.linearize(op_point=op, A_and_B=False, simplify=False)
     say("linearize_s", "%.4g" % (time.perf_counter() - t0))
     say("ops_linear", ops(Ml) + ops(Al))
@@ -100,7 +103,7 @@ def main():
     if len(sys.argv) > 2:
         # Rows n..2n-1 of M_l [q'; u'] = A_l [q; u]: M u' = -K q - C u up to the sign SymPy gives
         # the dynamic rows (Fr + Fr* = 0 has -M): normalised by the sign of M_11.
-        sub = {**params, **op}
+        sub = {**params, **op, **{qi: 0 for qi in q}}
         Mn = Ml[n:, n:].subs(sub).evalf()
         Kn = -Al[n:, :n].subs(sub).evalf()
         Cn = -Al[n:, n:].subs(sub).evalf()
