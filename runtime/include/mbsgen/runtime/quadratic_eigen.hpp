@@ -64,7 +64,10 @@ struct QuadraticEigenOptions {
     tropical             ///< two QZ runs with the tropical roots (Gaubert & Sharify; quadeig)
   };
   Scaling scaling = Scaling::automatic;
-  bool balance = true;               ///< LAPACK dggevx balancing (permute and scale), 'B'
+  /// Balance the linearization in dggevx: by permutation ('P'); when the largest backward error
+  /// then exceeds 10·f·u, once more with permutation and scaling ('B', Ward's algorithm, which is
+  /// not normwise safe on these pencils) keeping the better run. false: neither ('N').
+  bool balance = true;
   bool symmetric_fast_path = true;   ///< dsygvd when Q = 0, M = Mᵀ > 0, K = Kᵀ
   /// Rank tolerance tol of the deflation of zero and infinite eigenvalues; 0 means the default
   /// f·u (u = 2⁻⁵³). Two kinds of rank decision use it:
