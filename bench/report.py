@@ -237,8 +237,8 @@ w("")
 w("**Noise.** The machine has %s cores shared with other jobs (load averages above); the figures are "
   "medians of repetitions, but repeated runs still differ by tens of per cent. Read ratios measured in "
   "the same run, not digits. All BLAS/LAPACK calls, ours and Octave's, run single-threaded "
-  "(`OPENBLAS_NUM_THREADS=1`); with OpenBLAS's default threads small problems are slower on this shared "
-  "machine (the middle ear, time per frequency at F = %d):" % (system.get("nproc", "?"), F_REPORT))
+  "(`OPENBLAS_NUM_THREADS=1`); for comparison, the middle ear with OpenBLAS's default threads (time per "
+  "frequency at F = %d, same run):" % (system.get("nproc", "?"), F_REPORT))
 w("")
 threads = {r["method"]: r for r in read_csv(os.path.join("threads", "frf.csv"))}
 rows = []
@@ -257,8 +257,9 @@ w("- **Harness** (`bench/harness.hpp`): each measurement is the median of 5 repe
   "for modes, the default generator for generation).")
 w("- **Frequency responses** (`bench/frf_accuracy.cpp`): per problem F = %d log-spaced frequencies over its "
   "band, one input and one output. *Setup* (factorizations, reductions, eigen-solution) and *per frequency* "
-  "are measured apart: `compute()` on a fresh object minus `compute()` on one already set up (the runtime "
-  "sets up once per method). *Time per frequency* is setup/F + per frequency at F = %d; for other F use "
+  "are measured apart: per frequency from `compute()` of the F frequencies on an object already set up (the "
+  "runtime sets up once per method), setup as a fresh object's first `compute()` of one frequency minus one "
+  "frequency's time (`auto`: of the F frequencies, since it picks by their number). *Time per frequency* is setup/F + per frequency at F = %d; for other F use "
   "setup + F × per frequency (section 5 does). The error is the largest relative error |ẑ − ẑ_ref|/|ẑ_ref| "
   "over 25 of the frequencies against a **266-bit CLN reference** (`tests/runtime/hp.cpp`: the double "
   "inputs converted exactly, Gaussian elimination at 80 digits); a point the method flags as a pole (NaN) "
@@ -494,8 +495,12 @@ for p in mprobs:
             row.append("skipped")
     for m in ("polyeig", "eig", "eigs"):
         r = oby.get((p, m))
-        row.append("%s · %s" % (ftime(num(r["time_s"])), ferr(num(r["err_lowest_k"]))) if r and r["method"] != "timeout"
-                   else ("timeout" if (p, "timeout") in oby else "–"))
+        if r and r["time_s"] == "skipped":
+            row.append("skipped")
+        elif r:
+            row.append("%s · %s" % (ftime(num(r["time_s"])), ferr(num(r["err_lowest_k"]))))
+        else:
+            row.append("timeout" if (p, "timeout") in oby else "–")
     row.append(fratio(base, num(mby[(p, "symmetric")]["time_s"])))
     row.append(fratio(num(mby[(p, "symmetric")]["time_s"]), num(mby[(p, "partial")]["time_s"])))
     rows.append(row)
@@ -561,7 +566,7 @@ for chain in ("planar", "spatial"):
             rows.append([str(N) if v == "composite_cse" else "", r["coordinates"] if v == "composite_cse" else "", text,
                          ftime(num(r["generation_s"])), fratio(num(r["generation_s"]), num(base["generation_s"])),
                          r["ops_linear"], fratio(num(r["ops_linear"]), num(base["ops_linear"])),
-                         ftime(compile_s) if math.isfinite(compile_s) else "stopped (limit)",
+                         ftime(compile_s) if math.isfinite(compile_s) else "over the limit",
                          ftime(num(r["kernel_s"])), fratio(num(r["kernel_s"]), num(base["kernel_s"])),
                          ferr(num(r["max_rel_diff"]))])
         if chain == "planar" and N in sympy:
@@ -778,12 +783,14 @@ for p in problems:
         agree += good
         reason = ""
         if not good:
-            if size[p] < 12:
-                reason = "f < 12: direct by choice (accuracy)"
+            if size[p] < 12 and picked == "direct":
+                reason = "dense and f < 12: direct by choice (accuracy)"
             elif best.startswith("modal"):
                 reason = "modal is never automatic"
-            elif picked == "direct" and best == "hessenberg":
-                reason = "below auto's frequency threshold, or conditioning test"
+            elif {picked, best} == {"direct", "hessenberg"}:
+                reason = "near the break-even: this problem's F* differs from auto's threshold"
+            elif best.endswith("_float"):
+                reason = "single precision is never automatic"
             else:
                 reason = "rule and measurement differ"
         rows.append([label[p].split(" (")[0], str(F), best, picked, ("%.2g" % ratio) if math.isfinite(ratio) else "–",

@@ -106,7 +106,7 @@ log "generation (generation_cost ${q[*]:-})"
 "$build/bench/generation_cost" "$out" "${q[@]}" 2>"$out/generation.log"
 
 # ---- peers --------------------------------------------------------------------------------------
-if [ $quick -eq 1 ]; then sympy_sizes="2 5"; sympy_limit=60; oct_limit=60; else sympy_sizes="2 5 10 20 40"; sympy_limit=300; oct_limit=240; fi
+if [ $quick -eq 1 ]; then sympy_sizes="2 5"; sympy_limit=60; oct_limit=60; else sympy_sizes="2 5 10 20 40"; sympy_limit=180; oct_limit=240; fi
 echo "N,status,limit_s" >"$out/sympy_runs.csv"
 stop=0
 for N in $sympy_sizes; do
