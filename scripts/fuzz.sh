@@ -42,9 +42,9 @@ seeds_of() {
   rm -rf "$dir" && mkdir -p "$dir"
   if [ "$t" = model_reader ]; then
     local f
-    for f in models/*/*.yaml tests/data/bad_models/*.yaml; do
+    while IFS= read -r f; do
       ln -s "$PWD/$f" "$dir/$(echo "$f" | tr / _)"
-    done
+    done < <(find models -name '*.yaml'; ls tests/data/bad_models/*.yaml)
   else
     local n=0 line
     while IFS= read -r line; do
