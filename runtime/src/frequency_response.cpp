@@ -414,13 +414,14 @@ FrfMethod parse_frf_method(const std::string& name) {
 
 // The rule follows docs/accuracy-vs-time.md §5 (the recommendation table; measured by
 // bench/frf_accuracy.cpp, checked by tests/runtime/test_auto_method.cpp): banded wherever the
-// band is narrow (the fastest at every size and bandwidth up to b = n/4 in the sweep, as accurate
-// as direct); dense and below 12 coordinates direct, the backward-stable reference, since every
-// method costs microseconds there (the rotor: hessenberg 3× faster, 1000× less accurate); among
-// the dense methods hessenberg once its one-time reduction is paid back (break-even from about 8
-// frequencies at f = 12 to about 25 from f = 100 on), unless the first-order form is badly
-// conditioned: its error grows like u·κ(M̃)κ(K̃) (speaker_box: 4e-8 against direct's 3e-10),
-// so above 1e8 — or with M or K singular — direct.
+// band is narrow (faster than the dense methods on every chain and in the sweep up to b = n/4,
+// where it ties with hessenberg; as accurate as direct); dense and below 12 coordinates direct,
+// the backward-stable reference, since every method costs microseconds there (the rotor:
+// hessenberg 3× faster, 1000× less accurate); among the dense methods hessenberg once its
+// one-time reduction is paid back (break-even from about 8 frequencies at f = 12 to about 25–35
+// from f = 100 on), unless the first-order form is badly conditioned: its error grows like
+// u·κ(M̃)κ(K̃) (speaker_box: 4e-8 against direct's 3e-10), so above 1e8 — or with M or K
+// singular — direct.
 FrfMethod automatic_frf_method(const LinearModel& model, Index frequencies) {
   const Index n = model.size(), b = model.bandwidth();
   if (4 * b <= n && b * b <= 16 * n) return FrfMethod::banded;
