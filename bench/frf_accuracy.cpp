@@ -382,9 +382,7 @@ int main(int argc, char** argv) {
       sweep_bands = {2, 10, 50};
       reps = 3;
     } else if (a == "--sizes" && i + 1 < argc) {
-      sizes.clear();
-      std::stringstream s(argv[++i]);
-      for (std::string t; std::getline(s, t, ',');) sizes.push_back(std::stoi(t));
+      sizes = bench::parse_int_list(argv[++i]);
     } else if (a == "--reps" && i + 1 < argc) {
       reps = std::stoi(argv[++i]);
     } else if (a == "--only" && i + 1 < argc) {

@@ -155,14 +155,6 @@ void write_matrices(const Matrices& x, std::size_t n, const fs::path& file) {
   }
 }
 
-std::vector<int> parse_list(const char* s) {
-  std::vector<int> v;
-  std::stringstream in(s);
-  for (std::string t; std::getline(in, t, ',');)
-    if (!t.empty()) v.push_back(std::stoi(t));
-  return v;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -182,9 +174,9 @@ int main(int argc, char** argv) {
     } else if (a == "--compile-timeout" && i + 1 < argc) {
       timeout_s = std::stoi(argv[++i]);
     } else if (a == "--planar" && i + 1 < argc) {
-      planar = parse_list(argv[++i]);
+      planar = bench::parse_int_list(argv[++i]);
     } else if (a == "--spatial" && i + 1 < argc) {
-      spatial = parse_list(argv[++i]);
+      spatial = bench::parse_int_list(argv[++i]);
     }
   }
   fs::create_directories(out / "gen_matrices");

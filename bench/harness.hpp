@@ -98,4 +98,16 @@ inline std::string num(double x) {
   return b;
 }
 
+/// "10,30,100" → {10, 30, 100} (command-line size lists); empty items are skipped.
+inline std::vector<int> parse_int_list(const std::string& text) {
+  std::vector<int> v;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    if (end > start) v.push_back(std::stoi(text.substr(start, end - start)));
+    start = end + 1;
+  }
+  return v;
+}
+
 }  // namespace bench

@@ -3,23 +3,8 @@
 % DIR/chain_<n>/{M,Q,K,g_ref}.mtx are written by `runtime_bench --write-matrices DIR`.
 % Prints CSV lines: octave,<benchmark>,<n>,<seconds per frequency or per call>,<max rel err>
 
-function A = read_mm(f)
-  fid = fopen(f, 'r');
-  header = fgetl(fid);
-  line = fgetl(fid);
-  while numel(line) == 0 || line(1) == '%'
-    line = fgetl(fid);
-  end
-  dims = sscanf(line, '%d');
-  if ~isempty(strfind(header, 'coordinate'))
-    d = fscanf(fid, '%d %d %g', [3, dims(3)])';
-    A = sparse(d(:, 1), d(:, 2), d(:, 3), dims(1), dims(2));
-  else
-    d = fscanf(fid, '%g', dims(1) * dims(2));
-    A = reshape(d, dims(1), dims(2));
-  end
-  fclose(fid);
-end
+% read_mm: the Matrix Market reader shared with the peer scripts (bench/peers/read_mm.m).
+addpath(fullfile(fileparts(mfilename('fullpath')), '..', 'peers'));
 
 args = argv();
 dir = args{1};
