@@ -8,12 +8,18 @@
 // memory). checked_subs rebuilds an expression bottom-up with the values put in, one node at a
 // time, and refuses such a power before GiNaC evaluates it; a function's evaluation that throws
 // (log(0), tan(Pi/2)) is built on the stack, where GiNaC does not leak.
+//
+// checked_evalf evaluates in floating point the same way, bottom-up, and refuses what CLN would
+// get silently wrong or what leaves the range of double, where the generated kernels compute:
+// CLN returns exp(1e9999) = 1, sin(1e50) = 0 and tanh(1e100) = 0.
 #pragma once
 
 #include <ginac/ginac.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -69,7 +75,89 @@ inline void check_power(const GiNaC::ex& base, const GiNaC::ex& exponent, const 
                                 "2^20 binary digits)");
 }
 
+// The bounds checked_evalf applies to a function's argument x (its real part; the modulus for
+// the periodic functions).
+inline constexpr double kMaxPeriodicArgument = 1e15;  // beyond it the period is lost to rounding
+inline constexpr double kMaxExpArgument = 709.78;     // log(DBL_MAX) = 709.7827
+inline constexpr double kMinExpArgument = -745.13;    // below it exp(x) is 0 in double
+inline constexpr double kMaxHyperbolicArgument = 710.47;  // asinh(DBL_MAX) = 710.4758
+inline constexpr double kTanhSaturation = 60;  // 1 - tanh(60) < 1e-52: ±1 to 50 digits
+
+// Refuses a function's float argument beyond what CLN or double can honour, or returns the value
+// (tanh far out, where CLN returns 0 instead of ±1); returns nothing to let GiNaC evaluate.
+inline std::optional<GiNaC::ex> check_function(const std::string& name, const GiNaC::exvector& args,
+                                const GiNaC::ex& node) {
+  if (args.size() != 1 || !GiNaC::is_a<GiNaC::numeric>(args[0])) return std::nullopt;
+  const GiNaC::numeric& x = GiNaC::ex_to<GiNaC::numeric>(args[0]);
+  const double re = x.real().to_double();  // ±inf beyond double's range
+  if (name == "sin" || name == "cos" || name == "tan") {
+    if (!(GiNaC::abs(x).to_double() <= kMaxPeriodicArgument))
+      throw EvaluationError(node, name + "() of an argument beyond 1e15 in magnitude: its value is "
+                                         "lost to rounding");
+  } else if (name == "exp") {
+    if (re > kMaxExpArgument)
+      throw EvaluationError(node, "exp() overflows double: its argument exceeds 709.78");
+    if (re < kMinExpArgument)
+      throw EvaluationError(node, "exp() underflows double to 0: its argument is below -745.13");
+  } else if (name == "sinh" || name == "cosh") {
+    if (!(std::abs(re) <= kMaxHyperbolicArgument))
+      throw EvaluationError(node, name + "() overflows double: its argument exceeds 710.47 in "
+                                         "magnitude");
+  } else if (name == "tanh") {
+    if (x.is_real() && std::abs(re) > kTanhSaturation) return GiNaC::ex(re > 0 ? 1 : -1);
+  }
+  return std::nullopt;
+}
+
+inline bool all_real(const GiNaC::exvector& ops) {
+  return std::all_of(ops.begin(), ops.end(), [](const GiNaC::ex& o) {
+    return GiNaC::is_a<GiNaC::numeric>(o) && GiNaC::ex_to<GiNaC::numeric>(o).is_real();
+  });
+}
+
+inline bool is_nonreal_number(const GiNaC::ex& v) {
+  return GiNaC::is_a<GiNaC::numeric>(v) && !GiNaC::ex_to<GiNaC::numeric>(v).is_real();
+}
+
+// The function node `node` applied to `ops`, checked as check_function does and refused when real
+// numbers give a value that is not real (asin(2)).
+inline GiNaC::ex evaluate_function(const GiNaC::ex& node, const GiNaC::exvector& ops) {
+  const auto& f = GiNaC::ex_to<GiNaC::function>(node);
+  const auto fixed = check_function(f.get_name(), ops, node);
+  const GiNaC::ex v = fixed ? *fixed : GiNaC::ex(GiNaC::function(f.get_serial(), ops));
+  if (all_real(ops) && is_nonreal_number(v))
+    throw EvaluationError(node, "no real value (real arguments give a complex number)");
+  return v;
+}
+
 }  // namespace checked_subs_impl
+
+/// evalf(e) bottom-up (e holds no symbols, or keeps them as they are). Throws EvaluationError,
+/// naming the subexpression at fault, where a function leaves double's range or CLN's accuracy
+/// (see check_function), where real arguments give a value that is not real (asin(2),
+/// (-1)^0.5), and for any error of CLN (overflow, underflow, a pole).
+inline GiNaC::ex checked_evalf(const GiNaC::ex& e) {
+  using GiNaC::is_a;
+  const bool known = is_a<GiNaC::power>(e) || is_a<GiNaC::add>(e) || is_a<GiNaC::mul>(e) ||
+                     is_a<GiNaC::function>(e);
+  try {
+    if (!known) return GiNaC::evalf(e);  // numbers, constants, symbols
+    GiNaC::exvector ops;
+    ops.reserve(e.nops());
+    for (std::size_t i = 0; i < e.nops(); ++i) ops.push_back(checked_evalf(e.op(i)));
+    if (is_a<GiNaC::add>(e)) return GiNaC::evalf(GiNaC::add(ops));
+    if (is_a<GiNaC::mul>(e)) return GiNaC::evalf(GiNaC::mul(ops));
+    if (is_a<GiNaC::function>(e)) return GiNaC::evalf(checked_subs_impl::evaluate_function(e, ops));
+    const GiNaC::ex v = GiNaC::evalf(GiNaC::power(ops[0], ops[1]));
+    if (checked_subs_impl::all_real(ops) && checked_subs_impl::is_nonreal_number(v))
+      throw EvaluationError(e, "no real value (a negative number to a fractional power)");
+    return v;
+  } catch (const EvaluationError&) {
+    throw;
+  } catch (const std::exception& err) {
+    throw EvaluationError(e, err.what());
+  }
+}
 
 /// e.subs(values) (symbols to values, no patterns), evaluated bottom-up. Throws EvaluationError
 /// for a division by zero, a power too large to evaluate exactly, or any error of GiNaC's
@@ -94,7 +182,7 @@ inline GiNaC::ex checked_subs(const GiNaC::ex& e, const GiNaC::exmap& values) {
     }
     if (GiNaC::is_a<GiNaC::add>(e)) return GiNaC::add(ops);
     if (GiNaC::is_a<GiNaC::mul>(e)) return GiNaC::mul(ops);
-    return GiNaC::function(GiNaC::ex_to<GiNaC::function>(e).get_serial(), ops);
+    return checked_subs_impl::evaluate_function(e, ops);
   } catch (const EvaluationError&) {
     throw;
   } catch (const std::exception& err) {

@@ -238,7 +238,7 @@ void collect_symbols(const GiNaC::ex& e, std::set<std::string>& out) {
 double numeric_value(const GiNaC::ex& e, const GiNaC::exmap& defaults, bool& ok) {
   GiNaC::ex v;
   try {
-    v = GiNaC::evalf(detail::checked_subs(e, defaults));  // GiNaC's subs leaks when it throws
+    v = detail::checked_evalf(detail::checked_subs(e, defaults));  // GiNaC's subs leaks when it throws
   } catch (const std::exception&) {  // a pole (1/(m - 1) at m = 1), CLN's underflow: no value
     ok = false;
     return 0.0;

@@ -2,6 +2,7 @@
 // linearize.cpp decides structural zeros with it, check.cpp checks the operating point).
 #pragma once
 
+#include "checked_subs.hpp"
 #include "mbsgen/generator/program.hpp"
 
 #include <stdexcept>
@@ -82,7 +83,10 @@ class PointEvaluator {
     if (is_a<GiNaC::function>(e)) {
       GiNaC::exvector args;
       for (std::size_t i = 0; i < e.nops(); ++i) args.push_back(number(e.op(i)));
-      return float_of(GiNaC::function(GiNaC::ex_to<GiNaC::function>(e).get_serial(), args));
+      const auto& f = GiNaC::ex_to<GiNaC::function>(e);
+      // CLN's exp(1e9999) = 1 and sin(1e50) = 0: refused (EvaluationError), as in checked_evalf.
+      if (const auto fixed = checked_subs_impl::check_function(f.get_name(), args, e)) return float_of(*fixed);
+      return float_of(GiNaC::function(f.get_serial(), args));
     }
     return float_of(e);  // constants such as Pi
   }

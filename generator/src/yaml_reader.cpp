@@ -735,12 +735,13 @@ class Reader {
     for (const auto& p : model_->parameters()) values[p.symbol] = GiNaC::numeric(p.value);
     return values;
   }
-  // evalf(e.subs(values)) for the expression written at `n`; a pole (1/(m - 1) with m = 1) or a
-  // floating-point exception of CLN (exp(-1e9999) underflows) is a ModelError at `n`. (Through
-  // checked_subs: GiNaC's own subs leaks the node whose evaluation throws.)
+  // evalf(e.subs(values)) for the expression written at `n`; a pole (1/(m - 1) with m = 1), a
+  // floating-point exception of CLN (exp(-1e9999) underflows) or a value CLN would get wrong or
+  // double cannot hold (exp(1e9999), sin(1e50), asin(2): checked_evalf) is a ModelError at `n`.
+  // (Through checked_subs: GiNaC's own subs leaks the node whose evaluation throws.)
   GiNaC::ex evaluate(const YAML::Node& n, const GiNaC::ex& e, const GiNaC::exmap& values = {}) const {
     try {
-      return GiNaC::evalf(values.empty() ? e : detail::checked_subs(e, values));
+      return detail::checked_evalf(values.empty() ? e : detail::checked_subs(e, values));
     } catch (const std::exception& err) {
       fail(n, "cannot evaluate '" + n.Scalar() + "'" +
                   (values.empty() ? "" : " with the default parameter values") + ": " + err.what());

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -391,6 +392,42 @@ TEST(Errors, ApplicationSpecificKeysAreRejectedPerType) {
                             "outputs:\n  - {name: o, type: coordinate, coordinate: x, marker: p}\n"),
             "test.yaml:8:48: error: unknown key 'marker' in a coordinate output (allowed: name, "
             "type, unit, coordinate)");
+}
+
+// Values CLN evaluates wrongly without a word (exp(1e9999) = 1, sin(1e50) = 0, tanh(1e100) = 0)
+// or that double, where the kernels compute, cannot hold. The bounds are those of double: exp
+// overflows above log(DBL_MAX) = 709.78; the reference values are the C library's.
+std::string with_parameter(const std::string& value) {
+  return "model: v\nparameters: {c: " + value + "}\ncoordinates: [x]\n"
+         "bodies:\n  - {name: b, translation: [x, 0, 0], mass: 1}\n";
+}
+
+double parameter_value(const std::string& value) {
+  return mbsgen::read_model_string(with_parameter(value), "v.yaml").parameters().at(0).value;
+}
+
+TEST(Errors, ValuesCLNGetsWrongOrDoubleCannotHoldAreRefused) {
+  // Columns: the argument at fault (the caret under 710 in 'exp(710)').
+  EXPECT_NEAR(parameter_value("exp(709)"), std::exp(709.0), 1e-14 * std::exp(709.0));
+  EXPECT_EQ(error_of_string(with_parameter("exp(710)")),
+            "test.yaml:2:21: error: bad expression: exp() overflows double: its argument exceeds "
+            "709.78");
+  EXPECT_EQ(error_of_string(with_parameter("exp(1e9999)")),
+            "test.yaml:2:21: error: bad expression: exp() overflows double: its argument exceeds "
+            "709.78");
+  EXPECT_EQ(error_of_string(with_parameter("cosh(-711)")),
+            "test.yaml:2:23: error: bad expression: cosh() overflows double: its argument exceeds "
+            "710.47 in magnitude");
+  // 1e15 is an exact integer in double; the C library reduces it exactly, as CLN does.
+  EXPECT_NEAR(parameter_value("sin(1e15)"), std::sin(1e15), 1e-15);
+  EXPECT_EQ(error_of_string(with_parameter("sin(1e50)")),
+            "test.yaml:2:21: error: bad expression: sin() of an argument beyond 1e15 in magnitude: "
+            "its value is lost to rounding");
+  EXPECT_EQ(parameter_value("tanh(1e100)"), std::tanh(1e100));  // 1, where CLN says 0
+  EXPECT_EQ(parameter_value("tanh(-1e100)"), -1.0);
+  EXPECT_EQ(error_of_string(with_parameter("asin(2)")),
+            "test.yaml:2:17: error: cannot evaluate 'asin(2)': no real value (real arguments give a "
+            "complex number)");
 }
 
 // ---------------------------------------------------------------------------------------------

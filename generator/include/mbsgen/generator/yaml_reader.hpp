@@ -28,8 +28,11 @@ namespace detail {
 /// Parses one expression of a model file against `model.symbol_table()` (exposed for tests).
 /// Decimal literals (`0.5`, `1e-6`, `2.5E3`) become exact rationals; only the functions sin, cos,
 /// tan, asin, acos, atan, atan2, sinh, cosh, tanh, asinh, acosh, atanh, exp, log, sqrt, abs,
-/// pow and the constants Pi, Euler, Catalan are known. On error throws ExpressionError with the
-/// 0-based offset of the offending character within `text`.
+/// pow and the constants Pi, Euler, Catalan are known. Nesting (parentheses, calls, signs) is
+/// limited to 100 levels; exact powers whose numbers would exceed 2^20 bits, divisions by zero and
+/// constant function values outside double's range or CLN's accuracy (exp(1e9999), sin(1e50); see
+/// docs/model-format.md) are refused. On error throws ExpressionError with the 0-based offset of
+/// the offending character within `text`.
 GiNaC::ex parse_expression(const Model& model, const std::string& text);
 
 /// A bad expression: `offset` is the 0-based position within the expression text.
