@@ -509,7 +509,7 @@ struct FrequencyResponse::Impl {
   // ---- banded ----
   bool banded_ready = false;
   BandSolver band;
-  Eigen::VectorXd bxr, bxi, bzr, bzi;
+  Eigen::VectorXd bxr, bxi;
   Eigen::MatrixXd Bm, Bq, Bk;  // the bands of M, Q, K: row b + i − j of column j holds (i, j)
   void prepare_banded() {
     if (banded_ready) return;
@@ -980,8 +980,6 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
   im.z.resize(p);
   im.Cy_re = im.Cy.real();
   im.Cv_re = im.Cv.real();
-  im.bzr.resize(p);
-  im.bzi.resize(p);
 
   FrfMethod m = options_.method;
   if (m == FrfMethod::automatic) m = automatic_frf_method(model_, omega.size());
