@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -83,6 +84,20 @@ inline constexpr double kMinExpArgument = -745.13;    // below it exp(x) is 0 in
 inline constexpr double kMaxHyperbolicArgument = 710.47;  // asinh(DBL_MAX) = 710.4758
 inline constexpr double kTanhSaturation = 60;  // 1 - tanh(60) < 1e-52: ±1 to 50 digits
 
+// A number for a message: 6 significant digits, or its order of magnitude beyond double's range.
+inline std::string describe(const GiNaC::numeric& x) {
+  if (!x.is_real()) return "a complex number";
+  const double d = x.to_double();
+  char buf[40];
+  if (std::isfinite(d) && (d == 0 || std::abs(d) > 1e-300)) {
+    std::snprintf(buf, sizeof buf, "%.6g", d);
+  } else {
+    const double digits = GiNaC::log(GiNaC::abs(x)).to_double() / std::log(10.0);
+    std::snprintf(buf, sizeof buf, "%s1e%+.0f", x.is_negative() ? "-" : "", std::floor(digits + 1e-9));
+  }
+  return buf;
+}
+
 // Refuses a function's float argument beyond what CLN or double can honour, or returns the value
 // (tanh far out, where CLN returns 0 instead of ±1); returns nothing to let GiNaC evaluate.
 inline std::optional<GiNaC::ex> check_function(const std::string& name, const GiNaC::exvector& args,
@@ -90,18 +105,19 @@ inline std::optional<GiNaC::ex> check_function(const std::string& name, const Gi
   if (args.size() != 1 || !GiNaC::is_a<GiNaC::numeric>(args[0])) return std::nullopt;
   const GiNaC::numeric& x = GiNaC::ex_to<GiNaC::numeric>(args[0]);
   const double re = x.real().to_double();  // ±inf beyond double's range
+  const std::string call = name + "(" + describe(x) + ")";
   if (name == "sin" || name == "cos" || name == "tan") {
     if (!(GiNaC::abs(x).to_double() <= kMaxPeriodicArgument))
-      throw EvaluationError(node, name + "() of an argument beyond 1e15 in magnitude: its value is "
-                                         "lost to rounding");
+      throw EvaluationError(node, call + ": an argument beyond 1e15 in magnitude, where its value "
+                                         "is lost to rounding");
   } else if (name == "exp") {
     if (re > kMaxExpArgument)
-      throw EvaluationError(node, "exp() overflows double: its argument exceeds 709.78");
+      throw EvaluationError(node, call + " overflows double: its argument exceeds 709.78");
     if (re < kMinExpArgument)
-      throw EvaluationError(node, "exp() underflows double to 0: its argument is below -745.13");
+      throw EvaluationError(node, call + " underflows double to 0: its argument is below -745.13");
   } else if (name == "sinh" || name == "cosh") {
     if (!(std::abs(re) <= kMaxHyperbolicArgument))
-      throw EvaluationError(node, name + "() overflows double: its argument exceeds 710.47 in "
+      throw EvaluationError(node, call + " overflows double: its argument exceeds 710.47 in "
                                          "magnitude");
   } else if (name == "tanh") {
     if (x.is_real() && std::abs(re) > kTanhSaturation) return GiNaC::ex(re > 0 ? 1 : -1);
@@ -125,8 +141,12 @@ inline GiNaC::ex evaluate_function(const GiNaC::ex& node, const GiNaC::exvector&
   const auto& f = GiNaC::ex_to<GiNaC::function>(node);
   const auto fixed = check_function(f.get_name(), ops, node);
   const GiNaC::ex v = fixed ? *fixed : GiNaC::ex(GiNaC::function(f.get_serial(), ops));
-  if (all_real(ops) && is_nonreal_number(v))
-    throw EvaluationError(node, "no real value (real arguments give a complex number)");
+  if (all_real(ops) && is_nonreal_number(v)) {
+    std::string call = f.get_name() + "(";
+    for (std::size_t i = 0; i < ops.size(); ++i)
+      call += (i ? ", " : "") + describe(GiNaC::ex_to<GiNaC::numeric>(ops[i]));
+    throw EvaluationError(node, call + ") has no real value");
+  }
   return v;
 }
 
@@ -150,7 +170,7 @@ inline GiNaC::ex checked_evalf(const GiNaC::ex& e) {
     if (is_a<GiNaC::function>(e)) return GiNaC::evalf(checked_subs_impl::evaluate_function(e, ops));
     const GiNaC::ex v = GiNaC::evalf(GiNaC::power(ops[0], ops[1]));
     if (checked_subs_impl::all_real(ops) && checked_subs_impl::is_nonreal_number(v))
-      throw EvaluationError(e, "no real value (a negative number to a fractional power)");
+      throw EvaluationError(e, "a negative number to a fractional power has no real value");
     return v;
   } catch (const EvaluationError&) {
     throw;
