@@ -10,6 +10,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -1302,6 +1303,9 @@ Model read_model_string(const std::string& text, const std::string& file_name) {
 }
 
 Model read_model_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw ModelError({path, 0, 0}, "is a directory, not a model file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ModelError({path, 0, 0}, "cannot open the model file");
   std::ostringstream text;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -37,6 +38,8 @@ bool blank_or_comment(const std::string& l) {
 }  // namespace
 
 Eigen::MatrixXd read_matrix_market(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ParseError(path + ": is a directory, not a file");
   std::ifstream in(path);
   if (!in) throw ParseError(path + ": cannot open file");
   return read_matrix_market(in, path);

@@ -367,6 +367,9 @@ bodies:
 TEST(Errors, UnreadableFile) {
   const std::string path = kSourceDir + "/tests/data/no_such_model.yaml";
   EXPECT_EQ(error_of_file(path), path + ": error: cannot open the model file");
+  // A directory opens as a stream on Linux and reads as empty: named for what it is.
+  const std::string dir = kSourceDir + "/tests";
+  EXPECT_EQ(error_of_file(dir), dir + ": error: is a directory, not a model file");
 }
 
 TEST(Errors, FileNameOfAStringAndColumnsInQuotedScalars) {
