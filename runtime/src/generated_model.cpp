@@ -78,8 +78,11 @@ void GeneratedModel::set(const std::string& assignment) {
   char* end = nullptr;
   errno = 0;
   const double value = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || errno == ERANGE)
+  if (end == text.c_str() || *end != '\0')
     throw NameError("malformed value '" + text + "' for parameter '" + name + "': expected a number");
+  if (errno == ERANGE)  // beyond ±1.8e308, or below 2.2e-308 where strtod loses digits or all
+    throw NonFiniteError("value '" + text + "' for parameter '" + name +
+                         "' is outside the range of double (magnitudes 2.2e-308 to 1.8e308, or 0)");
   set(name, value);
 }
 

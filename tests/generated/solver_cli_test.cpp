@@ -51,6 +51,19 @@ TEST(GeneratedModel, SetByNameAndErrors) {
   EXPECT_THROW(m.set("g="), mbsgen::NameError);
   EXPECT_THROW(m.set("g=1.5x"), mbsgen::NameError);
   EXPECT_THROW(m.set("g", std::nan("")), mbsgen::NonFiniteError);
+  EXPECT_THROW(m.set("g=nan"), mbsgen::NonFiniteError);
+  EXPECT_THROW(m.set("g=-inf"), mbsgen::NonFiniteError);
+  // strtod says ERANGE: 1e400 would be inf, 1e-400 a silent 0.
+  for (const char* out_of_range : {"g=1e400", "g=1e-400"}) {
+    try {
+      m.set(out_of_range);
+      ADD_FAILURE() << out_of_range << " was accepted";
+    } catch (const mbsgen::NonFiniteError& e) {
+      EXPECT_NE(std::string(e.what()).find("outside the range of double"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_DOUBLE_EQ(m.linear_model().K()(1, 1), 1.0 * 1.62 * 1.0);  // unchanged by the refusals
   try {
     m.set("lenght=1");
     FAIL();
