@@ -18,7 +18,8 @@ struct Statement {
   GiNaC::ex symbol;       ///< for a temporary: the symbol that later statements use
 };
 
-/// Rewrites the statements so that every non-trivial subexpression (a sum, product, power or
+/// Merges temporaries whose values are equal or opposite (kept: the first), then rewrites the
+/// statements so that every non-trivial subexpression (a sum, product, power or
 /// function call, not a lone symbol, number or c·symbol) that occurs more than once is computed
 /// once into a new temporary `c<k>`, placed before its first use; e and −e count as the same
 /// subexpression. Deterministic: operands are visited in `order`, which must know the signs of
