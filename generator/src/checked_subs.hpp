@@ -105,20 +105,20 @@ inline std::optional<GiNaC::ex> check_function(const std::string& name, const Gi
   if (args.size() != 1 || !GiNaC::is_a<GiNaC::numeric>(args[0])) return std::nullopt;
   const GiNaC::numeric& x = GiNaC::ex_to<GiNaC::numeric>(args[0]);
   const double re = x.real().to_double();  // ±inf beyond double's range
-  const std::string call = name + "(" + describe(x) + ")";
+  // The message is built only when refusing: the operating-point evaluator passes every
+  // function value through here.
+  auto refuse = [&](const char* why) {
+    throw EvaluationError(node, name + "(" + describe(x) + ")" + why);
+  };
   if (name == "sin" || name == "cos" || name == "tan") {
     if (!(GiNaC::abs(x).to_double() <= kMaxPeriodicArgument))
-      throw EvaluationError(node, call + ": an argument beyond 1e15 in magnitude, where its value "
-                                         "is lost to rounding");
+      refuse(": an argument beyond 1e15 in magnitude, where its value is lost to rounding");
   } else if (name == "exp") {
-    if (re > kMaxExpArgument)
-      throw EvaluationError(node, call + " overflows double: its argument exceeds 709.78");
-    if (re < kMinExpArgument)
-      throw EvaluationError(node, call + " underflows double to 0: its argument is below -745.13");
+    if (re > kMaxExpArgument) refuse(" overflows double: its argument exceeds 709.78");
+    if (re < kMinExpArgument) refuse(" underflows double to 0: its argument is below -745.13");
   } else if (name == "sinh" || name == "cosh") {
     if (!(std::abs(re) <= kMaxHyperbolicArgument))
-      throw EvaluationError(node, call + " overflows double: its argument exceeds 710.47 in "
-                                         "magnitude");
+      refuse(" overflows double: its argument exceeds 710.47 in magnitude");
   } else if (name == "tanh") {
     if (x.is_real() && std::abs(re) > kTanhSaturation) return GiNaC::ex(re > 0 ? 1 : -1);
   }
