@@ -167,6 +167,7 @@ LinearEquations linearize(Equations& eq) {
     }
   split(lin.Q, lin.D, lin.G);
   split(lin.K, lin.Ks, lin.N);
+  lin.zeros = find_structural_zeros(eq, lin);
   return lin;
 }
 

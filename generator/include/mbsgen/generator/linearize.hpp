@@ -6,6 +6,7 @@
 #pragma once
 
 #include "mbsgen/generator/dynamics.hpp"
+#include "mbsgen/generator/structural_zeros.hpp"
 
 namespace mbsgen {
 
@@ -25,6 +26,9 @@ struct LinearEquations {
   /// "structure"). Where they vanish for all arguments (y0, ẏ0, p) of the kernels they are
   /// exact zeros, and Q and K exactly symmetric or skew (each pair of entries computed once).
   bool D_zero = false, G_zero = false, N_zero = false;
+  /// Exact structural zeros (structural_zeros.hpp): those zero everywhere are already 0 in the
+  /// matrices above; those zero at the operating point only are emitted as conditional zeros.
+  StructuralZeros zeros;
 };
 
 /// Linearizes about the model's operating point. Whether D, G, N vanish is decided by

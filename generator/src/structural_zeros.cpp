@@ -1,0 +1,228 @@
+#include "mbsgen/generator/structural_zeros.hpp"
+
+#include "mbsgen/generator/linearize.hpp"
+
+#include "point_evaluator.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <map>
+
+namespace mbsgen {
+
+using GiNaC::ex;
+using GiNaC::cos_SERIAL;
+using GiNaC::sin_SERIAL;
+using GiNaC::tan_SERIAL;
+
+namespace {
+
+// The matrices of the linear model, by name, in one list (the order of StructuralZeros).
+struct Target {
+  ExMatrix* matrix;
+  ZeroPattern* pattern;
+};
+
+std::vector<Target> targets(LinearEquations& lin, StructuralZeros& z) {
+  return {{&lin.M, &z.M},   {&lin.Q, &z.Q}, {&lin.K, &z.K}, {&lin.B, &z.B},   {&lin.Cy, &z.Cy},
+          {&lin.Cv, &z.Cv}, {&lin.D, &z.D}, {&lin.G, &z.G}, {&lin.Ks, &z.Ks}, {&lin.N, &z.N}};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Numerical screen
+
+// Candidates for zeros: entries below 1e-30 of their matrix's largest entry at two pseudo-random
+// points (50 digits; the rounding of the program's sums is ~1e-50 of their terms). A nonzero
+// analytic function is that small at both points only by a coincidence of measure zero, so every
+// entry the screen calls nonzero is nonzero; the proof below settles the candidates. A point
+// where evaluation fails (a pole) makes no candidates.
+std::vector<ZeroPattern> screen(Equations& eq, LinearEquations& lin, StructuralZeros& z,
+                                bool at_operating_point) {
+  std::vector<Target> ts = targets(lin, z);
+  std::vector<ex> entries;
+  for (const Target& t : ts)
+    for (const auto& row : *t.matrix) entries.insert(entries.end(), row.begin(), row.end());
+  std::vector<ZeroPattern> cand;
+  for (const Target& t : ts) {
+    ZeroPattern p(t.matrix->size());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i].assign((*t.matrix)[i].size(), EntryZero::nonzero);
+    cand.push_back(p);
+  }
+  const long digits = GiNaC::Digits;
+  GiNaC::Digits = detail::PointEvaluator::kDigits;
+  std::uint64_t state = at_operating_point ? 0x9e3779b97f4a7c15ULL : 0x2545f4914f6cdd1dULL;
+  try {
+    for (int point = 0; point < 2; ++point) {
+      GiNaC::exmap values;
+      for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p})
+        for (const auto& x : *group) {
+          state ^= state << 13, state ^= state >> 7, state ^= state << 17;  // xorshift64
+          values[x] = GiNaC::numeric(static_cast<long>(state % 2000000) + 500000, 1000000);
+        }
+      if (at_operating_point) {
+        GiNaC::exmap p;
+        for (const auto& x : eq.p) p[x] = values[x];
+        for (std::size_t k = 0; k < eq.y.size(); ++k) {
+          values[eq.y[k]] = GiNaC::evalf(lin.y0[k].subs(p, GiNaC::subs_options::no_pattern));
+          values[eq.yd[k]] = GiNaC::evalf(lin.yd0[k].subs(p, GiNaC::subs_options::no_pattern));
+        }
+      }
+      const std::vector<GiNaC::numeric> v = detail::PointEvaluator(eq.program, values).evaluate(entries);
+      std::size_t at = 0;
+      for (std::size_t m = 0; m < ts.size(); ++m) {
+        const ExMatrix& A = *ts[m].matrix;
+        const std::size_t begin = at;
+        GiNaC::numeric scale = 0;
+        for (const auto& row : A)
+          for (std::size_t j = 0; j < row.size(); ++j) scale = std::max(scale, GiNaC::abs(v[at++]));
+        const GiNaC::numeric tol = scale * GiNaC::numeric(10).power(-30);
+        at = begin;
+        for (std::size_t i = 0; i < A.size(); ++i)
+          for (std::size_t j = 0; j < A[i].size(); ++j, ++at) {
+            const bool small = GiNaC::abs(v[at]) <= tol && !A[i][j].is_zero();
+            EntryZero& c = cand[m][i][j];
+            if (point == 0) c = small ? EntryZero::everywhere : EntryZero::nonzero;
+            else if (!small) c = EntryZero::nonzero;
+          }
+      }
+    }
+  } catch (const std::exception&) {
+    for (auto& p : cand)
+      for (auto& row : p) std::fill(row.begin(), row.end(), EntryZero::nonzero);
+  }
+  GiNaC::Digits = digits;
+  return cand;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Symbolic proof
+
+// Number of nodes of e's tree (shared subtrees counted each time), stopping at `limit`.
+std::size_t tree_size(const ex& e, std::size_t limit) {
+  std::size_t n = 0;
+  std::vector<ex> stack{e};
+  while (!stack.empty() && n < limit) {
+    const ex x = stack.back();
+    stack.pop_back();
+    ++n;
+    for (std::size_t i = 0; i < x.nops(); ++i) stack.push_back(x.op(i));
+  }
+  return n;
+}
+
+// sin(a), cos(a), tan(a) → s_a, c_a, s_a/c_a, one pair of symbols per argument a.
+struct TrigToSymbols : GiNaC::map_function {
+  std::map<ex, std::pair<GiNaC::symbol, GiNaC::symbol>, GiNaC::ex_is_less> pairs;
+  const std::pair<GiNaC::symbol, GiNaC::symbol>& pair_of(const ex& a) {
+    auto it = pairs.find(a);
+    if (it == pairs.end()) it = pairs.emplace(a, std::make_pair(GiNaC::symbol(), GiNaC::symbol())).first;
+    return it->second;
+  }
+  ex operator()(const ex& e) override {
+    const bool s = is_ex_the_function(e, sin), c = is_ex_the_function(e, cos),
+               t = is_ex_the_function(e, tan);
+    if (s || c || t) {
+      const ex arg = e.op(0).map(*this);
+      const auto& [sa, ca] = pair_of(arg);
+      return s ? ex(sa) : c ? ex(ca) : ex(sa) / ca;
+    }
+    return e.map(*this);
+  }
+};
+
+// A polynomial in c_a of degree ≤ 1 for every argument a, using c² = 1 − s².
+ex reduce_pythagoras(ex e, const TrigToSymbols& trig) {
+  e = GiNaC::expand(e);
+  for (const auto& [arg, sc] : trig.pairs) {
+    const auto& [s, c] = sc;
+    for (int d = e.degree(c); d >= 2; d = e.degree(c)) {
+      const ex k = e.coeff(c, d);
+      e = GiNaC::expand(e - k * GiNaC::pow(c, d) + k * GiNaC::pow(c, d - 2) * (1 - GiNaC::pow(s, 2)));
+    }
+  }
+  return e;
+}
+
+// Written-out expressions beyond this many nodes are not expanded (expansion can swell them
+// exponentially); their candidates stay unproved.
+constexpr std::size_t kProofBudget = 20000;
+
+enum class Proof { zero, nonzero, too_large };
+
+Proof prove_zero(const ex& written_out) {
+  if (written_out.is_zero()) return Proof::zero;
+  if (tree_size(written_out, kProofBudget + 1) > kProofBudget) return Proof::too_large;
+  TrigToSymbols trig;
+  const ex symbolic = written_out.map(trig);
+  const ex numerator = GiNaC::normal(symbolic).numer();
+  if (tree_size(numerator, 50 * kProofBudget + 1) > 50 * kProofBudget) return Proof::too_large;
+  return reduce_pythagoras(numerator, trig).is_zero() ? Proof::zero : Proof::nonzero;
+}
+
+}  // namespace
+
+StructuralZeros find_structural_zeros(Equations& eq, LinearEquations& lin) {
+  StructuralZeros z;
+  std::vector<Target> ts = targets(lin, z);
+  for (const Target& t : ts) {
+    t.pattern->assign(t.matrix->size(), {});
+    for (std::size_t i = 0; i < t.matrix->size(); ++i)
+      (*t.pattern)[i].assign((*t.matrix)[i].size(), EntryZero::nonzero);
+  }
+  const std::vector<ZeroPattern> everywhere = screen(eq, lin, z, false);
+  const bool given = !lin.equilibrium;
+  const std::vector<ZeroPattern> at_op =
+      given ? screen(eq, lin, z, true) : std::vector<ZeroPattern>(ts.size());
+
+  // The operating point, substituted through the program once for all candidates.
+  GiNaC::exmap op_values;
+  for (std::size_t k = 0; k < eq.y.size(); ++k) {
+    op_values[eq.y[k]] = lin.y0[k];
+    op_values[eq.yd[k]] = lin.yd0[k];
+  }
+  Program::Substitution op(op_values);
+  for (std::size_t m = 0; m < ts.size(); ++m) {
+    ExMatrix& A = *ts[m].matrix;
+    for (std::size_t i = 0; i < A.size(); ++i)
+      for (std::size_t j = 0; j < A[i].size(); ++j) {
+        if (A[i][j].is_zero()) {
+          (*ts[m].pattern)[i][j] = EntryZero::everywhere;
+          continue;
+        }
+        EntryZero& result = (*ts[m].pattern)[i][j];
+        if (everywhere[m][i][j] == EntryZero::everywhere) {
+          const Proof p = prove_zero(eq.program.inline_all(A[i][j]));
+          if (p == Proof::zero) {
+            A[i][j] = 0;
+            result = EntryZero::everywhere;
+            ++z.everywhere;
+            continue;
+          }
+          if (p == Proof::too_large) ++z.unproved;
+        }
+        if (given && at_op[m][i][j] == EntryZero::everywhere) {
+          const ex at = eq.program.substitute(A[i][j], op);
+          const Proof p = prove_zero(eq.program.inline_all(at));
+          if (p == Proof::zero) {
+            result = EntryZero::at_operating_point;
+            ++z.at_operating_point;
+          } else if (p == Proof::too_large) {
+            ++z.unproved;
+          }
+        }
+      }
+  }
+  return z;
+}
+
+std::vector<std::string> pattern_rows(const ZeroPattern& pattern) {
+  std::vector<std::string> rows;
+  for (const auto& row : pattern) {
+    std::string s;
+    for (EntryZero e : row) s += e == EntryZero::nonzero ? 'x' : e == EntryZero::everywhere ? '0' : 'o';
+    rows.push_back(s);
+  }
+  return rows;
+}
+
+}  // namespace mbsgen
