@@ -131,6 +131,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  if (*generate && !id.empty() && !mbsgen::id_problem(id).empty()) {
+    std::cerr << "mbsgen generate: --id '" << id << "' " << mbsgen::id_problem(id) << "\n";
+    return 2;
+  }
   try {
     auto t0 = std::chrono::steady_clock::now();
     mbsgen::Model model = mbsgen::read_model_file(model_file);
@@ -150,11 +154,11 @@ int main(int argc, char** argv) {
     mbsgen::GeneratedCode code = mbsgen::emit(pruned, eq, lin, options);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (*info) return print_info(pruned, model.scenes(), lin, code, seconds);
-    mbsgen::write_generated(code, out_dir);
     const auto& range = pruned.selection().frequency_range;
-    mbsgen::write_api(mbsgen::emit_api(pruned, lin, code, scene, range ? range->from_hz : 0.0,
-                                       range ? range->to_hz : 0.0),
-                      out_dir);
+    mbsgen::write_generated(code,
+                            mbsgen::emit_api(pruned, lin, code, scene, range ? range->from_hz : 0.0,
+                                             range ? range->to_hz : 0.0),
+                            out_dir);
     std::cerr << "mbsgen: wrote " << out_dir << "/" << code.id << "{.hpp,.cpp,.json,_model.hpp,_model.cpp} in " << seconds
               << " s\n";
     return 0;

@@ -7,21 +7,29 @@
 #include "mbsgen/generator/check.hpp"
 #include "mbsgen/generator/emit.hpp"
 #include "mbsgen/generator/emit_api.hpp"
+#include "mbsgen/generator/output_files.hpp"
 #include "mbsgen/generator/scene.hpp"
 #include "mbsgen/generator/yaml_reader.hpp"
 #include "mbsgen_build_config.hpp"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <system_error>
+
+extern char** environ;
 
 namespace mbsgen::tool {
 
@@ -35,6 +43,28 @@ std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603U
   return h;
 }
 
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + p.string());
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A directory that only this user can write to, created (mode 0700) if missing: the cache holds
+// programs that `mbsgen run` executes, so one that another user owns or may write is refused.
+void ensure_private_directory(const fs::path& d) {
+  if (!d.parent_path().empty()) fs::create_directories(d.parent_path());
+  if (::mkdir(d.c_str(), 0700) != 0 && errno != EEXIST)
+    throw std::runtime_error("cannot create the solver cache " + d.string() + ": " + std::strerror(errno));
+  struct stat st;
+  if (::lstat(d.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != ::getuid() ||
+      (st.st_mode & S_IWOTH))
+    throw std::runtime_error("the solver cache " + d.string() +
+                             " is not a directory of this user that others cannot write to; "
+                             "set MBSGEN_CACHE_DIR to one");
+}
+
 fs::path cache_root() {
   if (const char* d = std::getenv("MBSGEN_CACHE_DIR"); d && *d) return d;
   if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return fs::path(d) / "mbsgen";
@@ -42,16 +72,20 @@ fs::path cache_root() {
   return fs::temp_directory_path() / ("mbsgen-cache-" + std::to_string(::getuid()));
 }
 
-std::string shell_quote(const std::string& s) {
-  std::string o = "'";
-  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return o + "'";
+// Words of a build-configuration string (flags and paths without spaces, as CMake wrote them).
+std::vector<std::string> words(const std::string& s) {
+  std::vector<std::string> out;
+  std::istringstream in(s);
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
 }
 
-// Where the runtime's headers and libraries are: beside an installed mbsgen (<prefix>/bin,
-// <prefix>/lib, <prefix>/include), otherwise in the build tree it was built in.
+// The compiler and where the runtime's headers and libraries are: beside an installed mbsgen
+// (<prefix>/bin, <prefix>/lib, <prefix>/include), otherwise in the build tree it was built in.
+// Each entry is one argument of the compiler: nothing passes through a shell.
 struct Toolchain {
-  std::string compiler, includes, libraries;
+  std::string compiler;
+  std::vector<std::string> includes, libraries;
 };
 
 Toolchain toolchain() {
@@ -63,24 +97,111 @@ Toolchain toolchain() {
   const fs::path installed_solver = prefix / MBSGEN_INSTALL_LIBDIR / MBSGEN_SOLVER_LIBRARY_NAME;
   if (!prefix.empty() && fs::exists(installed_solver) &&
       fs::exists(prefix / "include/mbsgen/runtime/solver_cli.hpp")) {
-    t.includes = "-I" + shell_quote((prefix / "include").string());
-    t.libraries = shell_quote(installed_solver.string()) + " " +
-                  shell_quote((prefix / MBSGEN_INSTALL_LIBDIR / MBSGEN_RUNTIME_LIBRARY_NAME).string());
+    t.includes = {"-I" + (prefix / "include").string()};
+    t.libraries = {installed_solver.string(),
+                   (prefix / MBSGEN_INSTALL_LIBDIR / MBSGEN_RUNTIME_LIBRARY_NAME).string()};
   } else {
-    t.includes = "-I" + shell_quote(MBSGEN_BUILD_RUNTIME_INCLUDE);
-    t.libraries = shell_quote(MBSGEN_BUILD_SOLVER_LIBRARY) + " " + shell_quote(MBSGEN_BUILD_RUNTIME_LIBRARY);
+    t.includes = {std::string("-I") + MBSGEN_BUILD_RUNTIME_INCLUDE};
+    t.libraries = {MBSGEN_BUILD_SOLVER_LIBRARY, MBSGEN_BUILD_RUNTIME_LIBRARY};
   }
-  t.includes += " " MBSGEN_EXTRA_INCLUDES;
-  t.libraries += " " MBSGEN_EXTRA_LIBRARIES;
+  for (auto& w : words(MBSGEN_EXTRA_INCLUDES)) t.includes.push_back(w);
+  for (auto& w : words(MBSGEN_EXTRA_LIBRARIES)) t.libraries.push_back(w);
   return t;
 }
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + p.string());
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+// Runs argv[0] (searched on PATH when it has no '/') with argv, its standard output and error
+// going to log; returns its exit status, or -1 when it could not run or was killed.
+int run_program(const std::vector<std::string>& args, const fs::path& log) {
+  const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) throw std::runtime_error("cannot create " + log.string() + ": " + std::strerror(errno));
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fd, STDOUT_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, fd, STDERR_FILENO);
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int error = ::posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(fd);
+  if (error != 0) throw std::runtime_error("cannot run " + args[0] + ": " + std::strerror(error));
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// The record written after a solver, last of a cache entry: its size and FNV-1a hash. It guards
+// against damage (a truncated or deleted solver), not against someone who can write the cache.
+std::string solver_record(const fs::path& solver) {
+  const std::string bytes = read_file(solver);
+  char line[80];
+  std::snprintf(line, sizeof line, "size %zu fnv1a64 %016llx\n", bytes.size(),
+                static_cast<unsigned long long>(fnv1a(bytes)));
+  return line;
+}
+
+// Whether the cache entry dir holds a sound solver; why not otherwise.
+bool sound_entry(const fs::path& dir, std::string& why) {
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) return false;
+  try {
+    if (!fs::exists(dir / "solve.sum")) why = "its record solve.sum is missing";
+    else if (!fs::exists(dir / "solve")) why = "the solver is missing";
+    else if (read_file(dir / "solve.sum") != solver_record(dir / "solve")) why = "the solver does not match its record";
+  } catch (const std::exception& e) {
+    why = e.what();
+  }
+  return why.empty();
+}
+
+// Generates and compiles the solver of model_file into the cache entry dir: in a private
+// directory (mkdtemp) beside it, renamed to dir when complete, so that neither a concurrent nor
+// an interrupted run leaves a half-built entry. Returns false when the compiler failed.
+bool build_solver(const std::string& model_file, const std::string& scene, const std::string& text,
+                  const Toolchain& tc, const fs::path& dir) {
+  const Model full = read_model_file(model_file);
+  const Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
+  Equations eq = derive(model);
+  LinearEquations lin = linearize(eq);
+  check_operating_point(eq, lin);
+  EmitOptions options;
+  options.scene = scene;
+  options.source_file = model_file;
+  options.id = "model";
+  GeneratedCode code = emit(model, eq, lin, options);
+  const auto& range = model.selection().frequency_range;
+  GeneratedApi api = emit_api(model, lin, code, scene, range ? range->from_hz : 0.0, range ? range->to_hz : 0.0);
+  std::string name = dir.string() + ".tmp-XXXXXX";
+  if (!::mkdtemp(name.data()))
+    throw std::runtime_error("cannot create a directory beside " + dir.string() + ": " + std::strerror(errno));
+  const fs::path work = name;
+  try {
+    write_generated(code, api, work.string());
+    write_files({{work / "main.cpp",
+                  "#include \"model_model.hpp\"\n#include \"mbsgen/runtime/solver_cli.hpp\"\n"
+                  "int main(int argc, char** argv) { return mbsgen::cli::solver_main(model::kernels(), argc, argv); }\n"},
+                 {work / "model.yaml", text}});  // the model this solver was made from, for reference
+    std::vector<std::string> args = {tc.compiler, "-O2", "-std=c++17"};
+    args.insert(args.end(), tc.includes.begin(), tc.includes.end());
+    for (const char* f : {"model.cpp", "model_model.cpp", "main.cpp"}) args.push_back((work / f).string());
+    args.insert(args.end(), {"-I" + work.string(), "-o", (work / "solve").string()});
+    args.insert(args.end(), tc.libraries.begin(), tc.libraries.end());
+    if (run_program(args, work / "compile.log") != 0) {
+      std::cerr << "mbsgen run: error: compiling the solver failed; see " << (work / "compile.log").string() << "\n";
+      return false;
+    }
+    write_files({{work / "solve.sum", solver_record(work / "solve")}});  // last: the entry is complete
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(work, ec);
+    throw;
+  }
+  std::error_code ec;
+  fs::rename(work, dir, ec);  // fails if another run won the race: then use its solver
+  if (ec) fs::remove_all(work, ec);
+  return true;
 }
 
 }  // namespace
@@ -94,68 +215,39 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
 #else
   const std::string text = read_file(model_file);  // throws: reported by the caller, exit 1
   const Toolchain tc = toolchain();
-  const std::string command_base = tc.compiler + " -O2 -std=c++17 " + tc.includes;
+  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
+  for (const auto& a : tc.includes) key += '\0' + a;
+  for (const auto& a : tc.libraries) key += '\0' + a;
   char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx",
-                static_cast<unsigned long long>(fnv1a(text + '\0' + scene + '\0' + kGeneratorVersion + '\0' +
-                                                      command_base + '\0' + tc.libraries)));
-  const fs::path dir = cache_root() / hash;
-  const fs::path solver = dir / "solve";
-  if (!fs::exists(solver)) {
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(key)));
+  const fs::path root = cache_root();
+  ensure_private_directory(root);
+  const fs::path dir = root / hash;
+  std::string why;
+  if (!sound_entry(dir, why)) {
+    std::error_code ec;
+    if (!why.empty()) {
+      std::cerr << "mbsgen run: the cached solver " << dir.string() << " is damaged (" << why << "): rebuilding it\n";
+      fs::remove_all(dir, ec);
+    }
     const bool terminal = ::isatty(STDERR_FILENO);
     if (terminal) std::cerr << "mbsgen run: generating and compiling the solver of " << model_file << " …" << std::flush;
     const auto t0 = std::chrono::steady_clock::now();
-    const Model full = read_model_file(model_file);
-    const Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
-    Equations eq = derive(model);
-    LinearEquations lin = linearize(eq);
-    check_operating_point(eq, lin);
-    EmitOptions options;
-    options.scene = scene;
-    options.source_file = model_file;
-    options.id = "model";
-    GeneratedCode code = emit(model, eq, lin, options);
-    const auto& range = model.selection().frequency_range;
-    GeneratedApi api = emit_api(model, lin, code, scene, range ? range->from_hz : 0.0, range ? range->to_hz : 0.0);
-    // Build in a private directory, then rename: a concurrent or interrupted run never leaves
-    // a half-built solver in the cache.
-    fs::create_directories(dir.parent_path());
-    const fs::path work = dir.parent_path() / (std::string(hash) + ".tmp-" + std::to_string(::getpid()));
-    fs::remove_all(work);
-    write_generated(code, work.string());
-    write_api(api, work.string());
-    {
-      std::ofstream m(work / "main.cpp");
-      m << "#include \"model_model.hpp\"\n#include \"mbsgen/runtime/solver_cli.hpp\"\n"
-           "int main(int argc, char** argv) { return mbsgen::cli::solver_main(model::kernels(), argc, argv); }\n";
-      std::ofstream s(work / "model.yaml");
-      s << text;  // the model this solver was made from, for reference
-    }
-    const std::string command = command_base + " -I" + shell_quote(work.string()) + " " +
-                                shell_quote((work / "model.cpp").string()) + " " +
-                                shell_quote((work / "model_model.cpp").string()) + " " +
-                                shell_quote((work / "main.cpp").string()) + " -o " +
-                                shell_quote((work / "solve").string()) + " " + tc.libraries + " 2>" +
-                                shell_quote((work / "compile.log").string());
-    const int rc = std::system(command.c_str());
-    if (rc != 0) {
-      std::cerr << (terminal ? "\n" : "") << "mbsgen run: error: compiling the solver failed; see "
-                << (work / "compile.log").string() << "\n";
-      return 1;
-    }
-    std::error_code ec;
-    fs::rename(work, dir, ec);  // fails if another run won the race: then use its solver
-    if (ec) fs::remove_all(work, ec);
+    if (!build_solver(model_file, scene, text, tc, dir)) return 1;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (terminal) std::cerr << " " << seconds << " s\n";
+    why.clear();
+    if (!sound_entry(dir, why))
+      throw std::runtime_error("the solver just built in " + dir.string() + " is not sound (" + why + ")");
   }
+  const fs::path solver = dir / "solve";
   std::vector<char*> argv;
   std::string name = fs::path(model_file).stem().string() + "-solve";
   argv.push_back(name.data());
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   ::execv(solver.c_str(), argv.data());
-  std::cerr << "mbsgen run: error: cannot execute " << solver.string() << "\n";
+  std::cerr << "mbsgen run: error: cannot execute " << solver.string() << ": " << std::strerror(errno) << "\n";
   return 1;
 #endif
 }

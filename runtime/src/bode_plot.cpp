@@ -1,37 +1,151 @@
 #include "bode_plot.hpp"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <system_error>
-
-#include <unistd.h>
 
 #include "mbsgen/runtime/error.hpp"
 #include "mbsgen/runtime/frequency_response.hpp"
 
+extern char** environ;
+
 namespace mbsgen::cli {
+
+namespace fs = std::filesystem;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string quoted(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    o += c;
+// A private directory (mkdtemp, mode 0700) under the temporary directory, removed with what it
+// holds when this goes out of scope.
+struct PrivateDirectory {
+  fs::path path;
+  PrivateDirectory() {
+    std::error_code ec;
+    const fs::path base = fs::temp_directory_path(ec);
+    if (ec) throw Error("--plot: no temporary directory: " + ec.message());
+    std::string name = (base / "mbsgen-bode-XXXXXX").string();
+    if (!::mkdtemp(name.data()))
+      throw Error("--plot: cannot create a directory in " + base.string() + ": " + std::strerror(errno));
+    path = name;
   }
-  return o + "\"";
+  ~PrivateDirectory() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  PrivateDirectory(const PrivateDirectory&) = delete;
+  PrivateDirectory& operator=(const PrivateDirectory&) = delete;
+};
+
+// Runs gnuplot on script with its standard output going to out_fd (the plot: no file name is
+// in the script) and its messages to log; returns gnuplot's exit status (-1: killed).
+int run_gnuplot(const fs::path& script, int out_fd, const fs::path& log) {
+  const int log_fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (log_fd < 0) throw Error("--plot: cannot create " + log.string() + ": " + std::strerror(errno));
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_adddup2(&actions, out_fd, STDOUT_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, log_fd, STDERR_FILENO);
+  std::string program = "gnuplot", file = script.string();
+  char* argv[] = {program.data(), file.data(), nullptr};
+  pid_t pid = 0;
+  const int error = ::posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(log_fd);
+  if (error != 0)
+    throw Error(std::string("--plot: cannot run gnuplot: ") + std::strerror(error) +
+                " (install Debian package gnuplot-nox)");
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// The script: data inline (a datablock), no file names, every label a gnuplot_string.
+std::string bode_script(const std::string& terminal, const Eigen::VectorXd& hz, const Eigen::VectorXcd& g,
+                        const BodePlot& plot) {
+  std::ostringstream s;
+  s << "set terminal " << terminal << "\n$bode << EOD\n";
+  for (Eigen::Index k = 0; k < hz.size(); ++k) {
+    const double a = std::abs(g[k]);
+    if (!std::isfinite(a) || a <= 0 || !(hz[k] > 0)) continue;  // log axes
+    char line[128];
+    std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", hz[k], a, phase_lag(g[k]) * 180.0 / kPi);
+    s << line;
+  }
+  s << "EOD\n"
+    << "set multiplot layout 2,1 title " << gnuplot_string(plot.title) << " noenhanced\n"
+    << "set xrange [" << hz.minCoeff() << ":" << hz.maxCoeff() << "]\n"
+    << "set logscale x\nset grid xtics ytics mxtics\nset format x '10^{%L}'\n"
+    << "set logscale y\nset format y '10^{%L}'\n"
+    << "set ylabel " << gnuplot_string(plot.amplitude_label) << " noenhanced\n"
+    << "unset key\n"
+    << "plot $bode using 1:2 with lines lw 2 lc rgb '#1f4e9c'\n"
+    << "unset logscale y\nset format y '%g'\n"
+    << "set ylabel 'phase lag [deg]'\nset xlabel 'frequency [Hz]'\n"
+    << "plot $bode using 1:3 with lines lw 2 lc rgb '#1f4e9c'\n"
+    << "unset multiplot\n";
+  return s.str();
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 }  // namespace
 
+std::string gnuplot_string(const std::string& s) {
+  std::string o = "'";
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c == '\'') {
+      o += "''";
+    } else if (c < 0x20 || c == 0x7F) {
+      o += ' ';
+    } else if (c < 0x80) {
+      o += static_cast<char>(c);
+    } else {
+      // Well-formed UTF-8 stays; any other byte becomes '?' (the plot's text must be UTF-8).
+      std::size_t n = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 ? 2 : 0;
+      bool ok = n > 0 && c <= 0xF4 && i + n <= s.size();
+      for (std::size_t k = 1; ok && k < n; ++k) ok = (static_cast<unsigned char>(s[i + k]) & 0xC0) == 0x80;
+      if (ok && n == 3) {
+        const unsigned c1 = static_cast<unsigned char>(s[i + 1]);
+        ok = !(c == 0xE0 && c1 < 0xA0) && !(c == 0xED && c1 > 0x9F);
+      } else if (ok && n == 4) {
+        const unsigned c1 = static_cast<unsigned char>(s[i + 1]);
+        ok = !(c == 0xF0 && c1 < 0x90) && !(c == 0xF4 && c1 > 0x8F);
+      }
+      if (!ok) {
+        o += '?';
+        continue;
+      }
+      o.append(s, i, n);
+      i += n - 1;
+    }
+  }
+  return o + "'";
+}
+
 void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const Eigen::VectorXcd& g,
                      const BodePlot& plot) {
-  namespace fs = std::filesystem;
   const std::string ext = fs::path(path).extension().string();
   std::string terminal;
   if (ext == ".svg")
@@ -41,63 +155,42 @@ void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const E
   else
     throw Error("--plot " + path + ": the file name must end in .svg or .png");
 
-  std::error_code ec;
-  const fs::path dir = fs::temp_directory_path(ec);
-  if (ec) throw Error("--plot: no temporary directory: " + ec.message());
-  const std::string stem = "mbsgen-bode-" + std::to_string(::getpid());
-  const fs::path data = dir / (stem + ".dat"), script = dir / (stem + ".gp");
+  PrivateDirectory work;
+  const fs::path script = work.path / "bode.gp", log = work.path / "gnuplot.log";
+  {
+    std::ofstream s(script, std::ios::binary);
+    s << bode_script(terminal, hz, g, plot);
+    if (!s.flush()) throw Error("--plot: cannot write " + script.string());
+  }
+  // The plot goes to a file created exclusively beside the target, then renamed over it.
   const fs::path target = fs::absolute(path);
-  const fs::path tmp = target.parent_path() / ("." + target.filename().string() + ".tmp");
-  struct Cleanup {
-    fs::path a, b, c;
-    ~Cleanup() {
-      std::error_code e;
-      fs::remove(a, e);
-      fs::remove(b, e);
-      fs::remove(c, e);
-    }
-  } cleanup{data, script, tmp};
-  {
-    std::ofstream d(data);
-    for (Eigen::Index k = 0; k < hz.size(); ++k) {
-      const double a = std::abs(g[k]);
-      if (!std::isfinite(a) || a <= 0 || !(hz[k] > 0)) continue;  // log axes
-      char line[128];
-      std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", hz[k], a, phase_lag(g[k]) * 180.0 / kPi);
-      d << line;
-    }
-    if (!d) throw Error("--plot: cannot write " + data.string());
+  std::string tmp = (target.parent_path() / ("." + target.filename().string() + ".XXXXXX.tmp")).string();
+  const int out_fd = ::mkstemps(tmp.data(), 4);
+  if (out_fd < 0) throw Error("--plot: cannot write in " + target.parent_path().string() + ": " + std::strerror(errno));
+  struct RemoveTemporary {
+    std::string path;
+    ~RemoveTemporary() { ::unlink(path.c_str()); }
+  } remove_tmp{tmp};
+  int status = -1;
+  try {
+    status = run_gnuplot(script, out_fd, log);
+  } catch (...) {
+    ::close(out_fd);
+    throw;
   }
-  {
-    std::ofstream s(script);
-    s << "set terminal " << terminal << "\n"
-      << "set output " << quoted(tmp.string()) << "\n"
-      << "set multiplot layout 2,1 title " << quoted(plot.title) << " noenhanced\n"
-      << "set xrange [" << hz.minCoeff() << ":" << hz.maxCoeff() << "]\n"
-      << "set logscale x\nset grid xtics ytics mxtics\nset format x '10^{%L}'\n"
-      << "set logscale y\nset format y '10^{%L}'\n"
-      << "set ylabel " << quoted(plot.amplitude_label) << " noenhanced\n"
-      << "unset key\n"
-      << "plot " << quoted(data.string()) << " using 1:2 with lines lw 2 lc rgb '#1f4e9c'\n"
-      << "unset logscale y\nset format y '%g'\n"
-      << "set ylabel 'phase lag [deg]'\nset xlabel 'frequency [Hz]'\n"
-      << "plot " << quoted(data.string()) << " using 1:3 with lines lw 2 lc rgb '#1f4e9c'\n"
-      << "unset multiplot\n";
-    if (!s) throw Error("--plot: cannot write " + script.string());
+  const bool written = ::lseek(out_fd, 0, SEEK_END) > 0;
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  const bool closed = ::fchmod(out_fd, 0666 & ~mask) == 0 && ::close(out_fd) == 0;
+  if (status != 0 || !written || !closed) {
+    const std::string messages = read_text(log);
+    throw Error("--plot: gnuplot failed" + (messages.empty() ? std::string(" (exit status ") +
+                                                                   std::to_string(status) + ")"
+                                                             : ": " + messages));
   }
-  const std::string command = "gnuplot " + quoted(script.string()) + " 2>&1";
-  FILE* p = popen(command.c_str(), "r");
-  if (!p) throw Error("--plot: cannot run gnuplot (install Debian package gnuplot-nox)");
-  std::string messages;
-  char buf[256];
-  while (std::fgets(buf, sizeof buf, p)) messages += buf;
-  const int status = pclose(p);
-  if (status != 0 || !fs::exists(tmp))
-    throw Error("--plot: gnuplot failed" +
-                (messages.empty() ? std::string(" (is it installed? Debian package gnuplot-nox)")
-                                  : ": " + messages));
-  fs::rename(tmp, target, ec);
-  if (ec) throw Error("--plot: cannot write " + target.string() + ": " + ec.message());
+  if (::rename(tmp.c_str(), target.c_str()) != 0)
+    throw Error("--plot: cannot write " + target.string() + ": " + std::strerror(errno));
+  remove_tmp.path.clear();
 }
 
 }  // namespace mbsgen::cli

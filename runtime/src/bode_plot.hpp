@@ -12,9 +12,16 @@ struct BodePlot {
   std::string amplitude_label;  // e.g. "|v_stapes / P| [(m/s)/Pa]"
 };
 
+/// s as a gnuplot single-quoted string: `'` doubled; controls (newlines included) and DEL become
+/// spaces, bytes that are not well-formed UTF-8 '?'. Gnuplot substitutes nothing inside single
+/// quotes (no backquote commands, no macros), so the string is text and nothing else.
+std::string gnuplot_string(const std::string& s);
+
 /// Writes a Bode plot (amplitude on a log scale and phase lag in degrees over a logarithmic
-/// frequency axis) of g(f) to `path` (.svg or .png). The file is written atomically (temporary
-/// file, then rename). Throws mbsgen::Error when gnuplot is missing or fails.
+/// frequency axis) of g(f) to `path` (.svg or .png). The file is written atomically (a temporary
+/// file created exclusively beside it, then rename); gnuplot runs without a shell on a script in
+/// a private temporary directory (mkdtemp) that names no file: data inline, the plot on its
+/// standard output. Throws mbsgen::Error when gnuplot is missing or fails.
 void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz,
                      const Eigen::VectorXcd& g, const BodePlot& plot);
 

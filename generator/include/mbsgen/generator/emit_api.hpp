@@ -21,8 +21,15 @@ struct GeneratedApi {
 GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const GeneratedCode& code,
                       const std::string& scene, double from_hz = 0, double to_hz = 0);
 
-/// Writes `<id>_model.hpp` and `<id>_model.cpp` into dir, atomically; unchanged files are not
-/// touched.
+/// `<id>_model.hpp` and `<id>_model.cpp` in dir, for write_files (output_files.hpp).
+std::vector<OutputFile> api_files(const GeneratedApi& api, const std::string& dir);
+
+/// Writes `<id>_model.hpp` and `<id>_model.cpp` into dir, both or neither; unchanged files are
+/// not touched.
 void write_api(const GeneratedApi& api, const std::string& dir);
+
+/// Writes the five files of `mbsgen generate` (write_generated's three and write_api's two)
+/// into dir, all or nothing (write_files): every target is checked before any is written.
+void write_generated(const GeneratedCode& code, const GeneratedApi& api, const std::string& dir);
 
 }  // namespace mbsgen
