@@ -222,11 +222,19 @@ struct Buffer {
   std::string name;
   std::vector<ex> values;  // name[i] = values[i]
   std::string doc;
+  std::vector<char> zero_at_op = {};  // name[i] is exactly 0 at the operating point
+};
+// A kernel's test whether it is called at the model's operating point: arguments[i] == values[i]
+// (structural_zeros.hpp); the entries marked zero_at_op are then set to exact zeros.
+struct OperatingPointTest {
+  std::vector<std::string> arguments;
+  std::vector<ex> values;
 };
 struct Kernel {
   std::string name, doc;
   std::vector<Argument> inputs;
   std::vector<Buffer> outputs;
+  OperatingPointTest at_op = {};
 };
 
 std::vector<ex> column_major(const ExMatrix& A, std::size_t rows, std::size_t cols) {
@@ -244,12 +252,30 @@ struct EmittedKernel {
   KernelInfo info;
 };
 
+// Sets the entries that are exact zeros at the operating point when the kernel is called
+// there (its arguments equal the operating point's values bit for bit; elsewhere the entries
+// keep their general expressions).
+std::string zeros_at_operating_point(const Kernel& k) {
+  std::ostringstream zeros;
+  for (const auto& b : k.outputs)
+    for (std::size_t i = 0; i < b.zero_at_op.size(); ++i)
+      if (b.zero_at_op[i]) zeros << "    " << b.name << "[" << i << "] = 0.0;\n";
+  if (zeros.str().empty()) return "";
+  std::ostringstream code;
+  code << "  // Exact zeros at the operating point (zero there for every parameter value).\n  if (";
+  for (std::size_t i = 0; i < k.at_op.arguments.size(); ++i)
+    code << (i ? " && " : "") << k.at_op.arguments[i] << " == op" << i;
+  code << ") {\n" << zeros.str() << "  }\n";
+  return code.str();
+}
+
 EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog, bool cse) {
   // Intermediates reachable from the outputs, in definition order.
   std::vector<char> needed(prog.definitions().size(), 0);
   std::vector<ex> stack;
   for (const auto& b : k.outputs)
     for (const auto& v : b.values) stack.push_back(v);
+  for (const auto& v : k.at_op.values) stack.push_back(v);
   while (!stack.empty()) {
     ex e = stack.back();
     stack.pop_back();
@@ -272,6 +298,8 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
   for (const auto& b : k.outputs)
     for (std::size_t i = 0; i < b.values.size(); ++i)
       statements.push_back({b.name + "[" + std::to_string(i) + "]", b.values[i], false, GiNaC::ex()});
+  for (std::size_t i = 0; i < k.at_op.values.size(); ++i)
+    statements.push_back({"const double op" + std::to_string(i), k.at_op.values[i], false, GiNaC::ex()});
   if (cse) statements = eliminate_common_subexpressions(statements, prog.order());
 
   CppPrinter printer(prog.order());
@@ -313,13 +341,63 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
   code << "// " << k.doc << "\n// operations: " << printer.operations << "\n";
   code << "extern \"C\" " << sig.str() << " {\n";
   for (const auto& a : k.inputs) code << "  (void)" << a.name << ";\n";
-  code << body.str();
+  code << body.str() << zeros_at_operating_point(k);
   code << "  int status = 0;\n";
   for (const auto& b : k.outputs)
     if (!b.values.empty())
       code << "  if (!all_finite(" << b.name << ", " << b.values.size() << ")) status = 1;\n";
   code << "  return status;\n}\n\n";
   return {code.str(), {k.name, sig.str(), printer.operations}};
+}
+
+// The linear kernels' entries that are zero at the operating point only (column-major, as
+// the buffers), and the test of the arguments against the operating point y0(p), ẏ0(p).
+void mark_zeros_at_operating_point(Kernel& k, const std::vector<const ZeroPattern*>& patterns,
+                                   Equations& eq, const LinearEquations& lin) {
+  bool any = false;
+  for (std::size_t b = 0; b < patterns.size(); ++b) {
+    const ZeroPattern& z = *patterns[b];
+    auto& flags = k.outputs[b].zero_at_op;
+    const std::size_t rows = z.size(), cols = rows ? z[0].size() : 0;
+    flags.assign(rows * cols, 0);
+    for (std::size_t j = 0; j < cols; ++j)
+      for (std::size_t i = 0; i < rows; ++i)
+        if (z[i][j] == EntryZero::at_operating_point) flags[j * rows + i] = 1, any = true;
+  }
+  if (!any) return;
+  const std::size_t f = lin.y0.size();
+  for (std::size_t i = 0; i < f; ++i) {
+    k.at_op.arguments.push_back("y0[" + std::to_string(i) + "]");
+    k.at_op.values.push_back(eq.program.define(lin.y0[i]));
+  }
+  if (lin.at_rest) return;
+  for (std::size_t i = 0; i < f; ++i)
+    if (std::find(lin.zero_rates.begin(), lin.zero_rates.end(), i) == lin.zero_rates.end()) {
+      k.at_op.arguments.push_back("yd0[" + std::to_string(i) + "]");
+      k.at_op.values.push_back(eq.program.define(lin.yd0[i]));
+    }
+}
+
+// The manifest's "sparsity": each linear matrix's rows as strings, 'x' an entry that may be
+// nonzero, '0' an exact zero, 'o' an exact zero at the operating point (general elsewhere); and
+// how many zeros were proved of each kind (structural_zeros.hpp).
+std::string sparsity_json(const LinearEquations& lin) {
+  const StructuralZeros& z = lin.zeros;
+  std::ostringstream j;
+  j << "{\"legend\": \"x may be nonzero, 0 exact zero, o exact zero at the operating point\", "
+    << "\"zero_everywhere\": " << z.everywhere << ", \"zero_at_operating_point\": "
+    << z.at_operating_point << ", \"unproved_candidates\": " << z.unproved;
+  const std::pair<const char*, const ZeroPattern*> matrices[] = {
+      {"M", &z.M}, {"Q", &z.Q},   {"K", &z.K}, {"B", &z.B}, {"C_y", &z.Cy}, {"C_v", &z.Cv},
+      {"D", &z.D}, {"G", &z.G}, {"K_s", &z.Ks}, {"N", &z.N}};
+  for (const auto& [name, pattern] : matrices) {
+    j << ",\n    \"" << name << "\": [";
+    const std::vector<std::string> rows = pattern_rows(*pattern);
+    for (std::size_t i = 0; i < rows.size(); ++i) j << (i ? ", " : "") << "\"" << rows[i] << "\"";
+    j << "]";
+  }
+  j << "}";
+  return j.str();
 }
 
 }  // namespace
@@ -370,6 +448,10 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
                       {"G", column_major(lin.G, f, f), ""},
                       {"Ks", column_major(lin.Ks, f, f), ""},
                       {"N", column_major(lin.N, f, f), ""}}});
+  mark_zeros_at_operating_point(kernels[kernels.size() - 2], {&lin.zeros.M, &lin.zeros.Q, &lin.zeros.K,
+                                &lin.zeros.B, &lin.zeros.Cy, &lin.zeros.Cv}, eq, lin);
+  mark_zeros_at_operating_point(kernels.back(), {&lin.zeros.M, &lin.zeros.D, &lin.zeros.G,
+                                &lin.zeros.Ks, &lin.zeros.N}, eq, lin);
   kernels.push_back({"operating_point",
                      "operating point y0 (or the initial guess of an equilibrium) and steady rates yd0",
                      {{"p", p}},
@@ -527,7 +609,8 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   }
   auto zero = [](bool z) { return z ? "\"zero\"" : "\"nonzero\""; };
   j << "\n  ],\n  \"structure\": {\"D\": " << zero(lin.D_zero) << ", \"G\": " << zero(lin.G_zero)
-    << ", \"N\": " << zero(lin.N_zero) << "},\n  \"kernels\": [";
+    << ", \"N\": " << zero(lin.N_zero) << "},\n  \"sparsity\": " << sparsity_json(lin)
+    << ",\n  \"kernels\": [";
   for (std::size_t i = 0; i < out.kernels.size(); ++i)
     j << (i ? "," : "") << "\n    {\"name\": " << json_string(out.kernels[i].name)
       << ", \"operations\": " << out.kernels[i].operations

@@ -23,8 +23,9 @@ struct Structure {
 // the matrix's largest entry at both points. A nonzero analytic function vanishes only on a set
 // of measure zero, and 15 digits of margin cover the cancellation in the sums, so the test errs
 // in neither direction in practice; a point where the evaluation fails (a pole) gives
-// "nonzero", the safe answer.
-Structure structure_of(const Equations& eq, const LinearEquations& lin, bool at_operating_point) {
+// "nonzero", the safe answer. A numerical "zero" is then proved symbolically entry by entry
+// (structural_zeros.hpp), so that a part 1e-40 of the rest is not taken for zero.
+Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operating_point) {
   const std::size_t f = lin.Q.size();
   std::vector<ex> entries;
   for (const ExMatrix* A : {&lin.Q, &lin.K})
@@ -73,6 +74,26 @@ Structure structure_of(const Equations& eq, const LinearEquations& lin, bool at_
     s = Structure{};
   }
   GiNaC::Digits = digits;
+  // The screen's "zero" is a candidate; only a symbolic proof of every entry makes it so (a part
+  // 1e-40 of the rest is not zero).
+  GiNaC::exmap op_values;
+  if (at_operating_point)
+    for (std::size_t k = 0; k < f; ++k) {
+      if (!lin.equilibrium) op_values[eq.y[k]] = lin.y0[k];
+      op_values[eq.yd[k]] = lin.yd0[k];
+    }
+  Program::Substitution op(op_values);
+  auto proved = [&](const ExMatrix& A, int sign) {
+    for (std::size_t i = 0; i < f; ++i)
+      for (std::size_t j = 0; j <= i; ++j) {
+        const ex e = A[i][j] + sign * A[j][i];
+        if (!proved_zero(eq.program, at_operating_point ? eq.program.substitute(e, op) : e)) return false;
+      }
+    return true;
+  };
+  s.D_zero = s.D_zero && proved(lin.Q, 1);
+  s.G_zero = s.G_zero && proved(lin.Q, -1);
+  s.N_zero = s.N_zero && proved(lin.K, -1);
   return s;
 }
 

@@ -215,6 +215,10 @@ StructuralZeros find_structural_zeros(Equations& eq, LinearEquations& lin) {
   return z;
 }
 
+bool proved_zero(Program& program, const ex& e) {
+  return e.is_zero() || prove_zero(program.inline_all(e)) == Proof::zero;
+}
+
 std::vector<std::string> pattern_rows(const ZeroPattern& pattern) {
   std::vector<std::string> rows;
   for (const auto& row : pattern) {

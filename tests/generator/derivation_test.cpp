@@ -2,7 +2,9 @@
 // intermediates written out and exact rational parameters, must equal exact reference matrices.
 #include "mbsgen/generator/chain.hpp"
 #include "mbsgen/generator/cse.hpp"
+#include "mbsgen/generator/emit.hpp"
 #include "mbsgen/generator/linearize.hpp"
+#include "mbsgen/generator/yaml_reader.hpp"
 
 #include <gtest/gtest.h>
 
@@ -83,6 +85,58 @@ TEST(Cse, MergesEqualAndOppositeTemporaries) {
     EXPECT_TRUE((before[i] - after[i]).expand().is_zero()) << before[i] << " vs " << after[i];
   const ex expected = -numeric(15, 77) * GiNaC::sin(ex(numeric(3, 7)));  // −x·y·sin x, exact
   EXPECT_TRUE((after[1] - expected).expand().is_zero()) << after[1];
+}
+
+}  // namespace
+}  // namespace mbsgen
+
+
+namespace mbsgen {
+namespace {
+
+// Exact structural zeros (issue 14 §1) and the manifest's sparsity, for the heavy top in steady
+// precession. From its Lagrangian (models/textbook/heavy_top_precession.yaml), with s = sin θ,
+// c = cos θ: M = [[I1 s² + I3 c², 0, I3 c], [0, I1, 0], [I3 c, 0, I3]] for every θ; psi and phi
+// are cyclic, so K's columns of psi and phi vanish for every state; K(psi, theta) and
+// K(phi, theta) are θ̇ times a function of θ (d/dt of the momenta p_psi, p_phi), zero at the
+// steady precession (θ̇ = 0) only.
+TEST(StructuralZeros, HeavyTopPatternFollowsFromTheLagrangian) {
+  const Model model = read_model_file(std::string(MBSGEN_SOURCE_DIR) + "/models/textbook/heavy_top_precession.yaml");
+  Equations eq = derive(model);
+  LinearEquations lin = linearize(eq);
+  EXPECT_EQ(pattern_rows(lin.zeros.M), (std::vector<std::string>{"x0x", "0x0", "x0x"}));
+  EXPECT_EQ(pattern_rows(lin.zeros.K), (std::vector<std::string>{"0o0", "0x0", "0o0"}));
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_TRUE(lin.K[i][0].is_zero()) << i;
+    EXPECT_TRUE(lin.K[i][2].is_zero()) << i;
+  }
+  EXPECT_EQ(lin.zeros.unproved, 0u);
+  // Zeros at the operating point only are not written into the general matrices.
+  EXPECT_FALSE(lin.K[0][1].is_zero());
+  // The manifest records the pattern.
+  const GeneratedCode code = emit(model, eq, lin, EmitOptions{});
+  EXPECT_NE(code.manifest.find("\"K\": [\"0o0\", \"0x0\", \"0o0\"]"), std::string::npos) << code.manifest;
+  EXPECT_NE(code.source.find("  if (y0[0] == op0 && y0[1] == op1 && y0[2] == op2 && yd0[0] == op3 && yd0[1] == op4 && yd0[2] == op5) {"),
+            std::string::npos);
+}
+
+// A numerically tiny entry that is not zero (a constant 1e-40 in the model) stays an
+// expression: the symbolic proof, not the 50-digit screen, decides.
+TEST(StructuralZeros, TinyButNonzeroEntriesAreKept) {
+  const Model model = read_model_string(R"(model: tiny
+parameters: {m: 1, k: 100}
+coordinates: [x, y]
+bodies:
+  - {name: b, translation: [x, y, 0], mass: m}
+forces:
+  - {type: generalized, coordinate: x, value: -k*x - 1e-40*k*y}
+  - {type: generalized, coordinate: y, value: -k*y}
+)",
+                                          "tiny.yaml");
+  Equations eq = derive(model);
+  LinearEquations lin = linearize(eq);
+  EXPECT_EQ(pattern_rows(lin.zeros.K), (std::vector<std::string>{"xx", "0x"}));
+  EXPECT_FALSE(lin.K[0][1].is_zero());
 }
 
 }  // namespace

@@ -83,6 +83,7 @@ INSTANTIATE_TEST_SUITE_P(
                     TextbookCase{"rotor_disk.yaml", 3, 2},
                     TextbookCase{"jeffcott_rotor.yaml", 2, 1},
                     TextbookCase{"sleeping_top.yaml", 3, 1},
+                    TextbookCase{"heavy_top_precession.yaml", 3, 1},
                     TextbookCase{"ziegler_column.yaml", 2, 2},
                     TextbookCase{"chain3_sympy.yaml", 3, 3}),
     [](const testing::TestParamInfo<TextbookCase>& param_info) {
@@ -94,7 +95,7 @@ TEST(TextbookModels, EveryFileIsListed) {
   std::size_t n = 0;
   for (const auto& entry : fs::directory_iterator(kSourceDir + "/models/textbook"))
     if (entry.path().extension() == ".yaml") ++n;
-  EXPECT_EQ(n, 13u) << "a model file was added or removed: update the list of TextbookModel";
+  EXPECT_EQ(n, 14u) << "a model file was added or removed: update the list of TextbookModel";
 }
 
 TEST(DoublePendulum, ContentsAsWritten) {

@@ -55,6 +55,10 @@ struct StructuralZeros {
 /// point only are returned in the pattern (emit() writes them as conditional zeros).
 StructuralZeros find_structural_zeros(Equations& eq, LinearEquations& lin);
 
+/// True when e (an expression of the program) is proved zero for all values of its variables
+/// by the symbolic proof above (false when it is not zero or not proved within the budget).
+bool proved_zero(Program& program, const GiNaC::ex& e);
+
 /// A matrix's pattern as rows of characters: 'x' nonzero, '0' zero everywhere, 'o' zero at the
 /// operating point (the manifest's "sparsity").
 std::vector<std::string> pattern_rows(const ZeroPattern& pattern);
