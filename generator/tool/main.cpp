@@ -40,6 +40,8 @@ int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& sce
               << (e.note.empty() ? "" : ": " + e.note) << "\n";
   std::cout << "  structure: D " << (lin.D_zero ? "zero" : "nonzero") << ", G "
             << (lin.G_zero ? "zero" : "nonzero") << ", N " << (lin.N_zero ? "zero" : "nonzero") << "\n";
+  std::cout << "  exact zeros: " << lin.zeros.everywhere << " everywhere, " << lin.zeros.at_operating_point
+            << " at the operating point, " << lin.zeros.unproved << " candidates unproved (manifest: sparsity)\n";
   std::cout << "bodies (" << model.bodies().size() << "):";
   for (const auto& b : model.bodies()) std::cout << " " << b.name << "<-" << b.parent;
   std::cout << "\ncoordinates (" << model.coordinates().size() << "):";
@@ -103,13 +105,14 @@ int run_command(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
 #ifdef MBSGEN_HAVE_LINEAR_CLI
   if (argc >= 2 && std::strcmp(argv[1], "linear") == 0) return mbsgen::cli::linear_main(argc - 1, argv + 1);
 #endif
   if (argc >= 2 && std::strcmp(argv[1], "run") == 0) return run_command(argc, argv);
   CLI::App app{"mbsgen: symbolic-to-numeric code generator for multibody systems"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("mbsgen ") + mbsgen::kGeneratorVersion, "print the version and exit");
   std::string model_file, out_dir, scene = "full", id;
   bool no_cse = false;
   auto* check = app.add_subcommand("check", "read and validate a model file (and its operating point)");
@@ -169,4 +172,7 @@ int main(int argc, char** argv) {
     std::cerr << "mbsgen: error: " << e.what() << "\n";
     return 1;
   }
+} catch (const std::exception& e) {  // anywhere else, `mbsgen linear` and `mbsgen run` included
+  std::cerr << "mbsgen: error: " << e.what() << "\n";
+  return 1;
 }
