@@ -135,10 +135,18 @@ int run_program(const std::vector<std::string>& args, const fs::path& log) {
 // The record written after a solver, last of a cache entry: its size and FNV-1a hash. It guards
 // against damage (a truncated or deleted solver), not against someone who can write the cache.
 std::string solver_record(const fs::path& solver) {
-  const std::string bytes = read_file(solver);
+  std::ifstream in(solver, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + solver.string());
+  std::uint64_t h = 1469598103934665603ULL;
+  std::size_t size = 0;
+  std::string chunk(1 << 16, '\0');
+  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
+    const auto n = static_cast<std::size_t>(in.gcount());
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ static_cast<unsigned char>(chunk[i])) * 1099511628211ULL;
+    size += n;
+  }
   char line[80];
-  std::snprintf(line, sizeof line, "size %zu fnv1a64 %016llx\n", bytes.size(),
-                static_cast<unsigned long long>(fnv1a(bytes)));
+  std::snprintf(line, sizeof line, "size %zu fnv1a64 %016llx\n", size, static_cast<unsigned long long>(h));
   return line;
 }
 
