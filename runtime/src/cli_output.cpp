@@ -30,6 +30,25 @@ std::string short_num(double v) {
   return buf;
 }
 
+std::string sweep_problem(double from_hz, double to_hz, long points, bool log_spacing) {
+  const std::string range = "--from " + num(from_hz, false) + " --to " + num(to_hz, false);
+  if (log_spacing && (from_hz <= 0 || to_hz <= 0))
+    return "--spacing log needs --from and --to > 0 (got " + range + ")";
+  if (to_hz < from_hz || (points > 1 && to_hz == from_hz))
+    return "empty range " + range + " (--from must be below --to, or equal to it with --points 1)";
+  return "";
+}
+
+Eigen::VectorXd sweep_hz(double from_hz, double to_hz, long points, bool log_spacing) {
+  Eigen::VectorXd hz(points);
+  for (long k = 0; k < points; ++k) {
+    const double t = points == 1 ? 0.0 : static_cast<double>(k) / static_cast<double>(points - 1);
+    hz[k] = log_spacing ? from_hz * std::pow(to_hz / from_hz, t) : from_hz + (to_hz - from_hz) * t;
+  }
+  if (points > 0) hz[points - 1] = to_hz;
+  return hz;
+}
+
 std::string pad(const std::string& s, std::size_t w) {
   return s.size() >= w ? s : std::string(w - s.size(), ' ') + s;
 }

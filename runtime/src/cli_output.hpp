@@ -36,6 +36,15 @@ inline CLI::Validator frequency_hz() {
       },
       "HZ", "frequency_hz");
 }
+/// The most frequencies a sweep may have (--points of both command lines): a sweep keeps its
+/// results in memory (about 100 bytes a point) before printing them (about 100 bytes a line).
+inline constexpr long kMaxFrequencyPoints = 1'000'000;
+/// Checks a sweep's range as both command lines take it; "" when valid, else the reason (a usage
+/// error): log spacing needs from, to > 0; from must not exceed to, and equals it only for one
+/// point.
+std::string sweep_problem(double from_hz, double to_hz, long points, bool log_spacing);
+/// The frequencies of a valid sweep [Hz], both ends included (the last exactly to_hz).
+Eigen::VectorXd sweep_hz(double from_hz, double to_hz, long points, bool log_spacing);
 /// Right-aligned in a field of width w.
 std::string pad(const std::string& s, std::size_t w);
 /// A JSON string literal.

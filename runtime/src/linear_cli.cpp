@@ -4,15 +4,18 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <new>
 #include <string>
 #include <vector>
 
 #include "cli_output.hpp"
 #include "mbsgen/runtime/error.hpp"
 #include "mbsgen/runtime/frequency_response.hpp"
+#include "mbsgen/runtime/generated_model.hpp"
 #include "mbsgen/runtime/linear_model.hpp"
 #include "mbsgen/runtime/matrix_market.hpp"
 #include "mbsgen/runtime/quadratic_eigen.hpp"
+#include "mbsgen/runtime/version.hpp"
 
 namespace mbsgen::cli {
 namespace {
@@ -56,18 +59,14 @@ struct FrfArgs {
 
 int run_frf(const Common& c, const FrfArgs& a, std::ostream& out, std::ostream& err) {
   const LinearModel model = load(c, a.B, a.C, a.Cv);
+  // Out of the model's range: a usage error (exit status 2), like an unknown name for a solver.
   if (a.input < 1 || a.input > model.num_inputs())
-    throw DimensionError("--input " + std::to_string(a.input) + " out of range 1.." +
-                         std::to_string(model.num_inputs()));
+    throw NameError("--input " + std::to_string(a.input) + " out of range 1.." +
+                    std::to_string(model.num_inputs()) + " (the columns of B)");
   if (a.output < 1 || a.output > model.num_outputs())
-    throw DimensionError("--output " + std::to_string(a.output) + " out of range 1.." +
-                         std::to_string(model.num_outputs()));
-  Eigen::VectorXd hz(a.points);
-  for (long k = 0; k < a.points; ++k) {
-    const double t = a.points == 1 ? 0.0 : static_cast<double>(k) / static_cast<double>(a.points - 1);
-    hz[k] = a.spacing == "log" ? a.from * std::pow(a.to / a.from, t) : a.from + (a.to - a.from) * t;
-  }
-  if (a.points > 0) hz[a.points - 1] = a.to;
+    throw NameError("--output " + std::to_string(a.output) + " out of range 1.." +
+                    std::to_string(model.num_outputs()) + " (the rows of C)");
+  const Eigen::VectorXd hz = sweep_hz(a.from, a.to, a.points, a.spacing == "log");
   FrfOptions opt;
   opt.method = parse_frf_method(a.method);
   opt.on_pole = a.on_pole == "error" ? PoleHandling::raise : PoleHandling::flag;
@@ -84,11 +83,12 @@ int run_frf(const Common& c, const FrfArgs& a, std::ostream& out, std::ostream& 
 
 }  // namespace
 
-int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
+int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) try {
   CLI::App app{"mbsgen linear: modes and frequency responses of M y'' + Q y' + K y = B u, "
                "z = C y, from Matrix Market files"};
   app.name("mbsgen linear");
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("mbsgen linear ") + kRuntimeVersion, "print the version and exit");
   Common c;
   bool all = false;
   FrfArgs a;
@@ -116,7 +116,7 @@ int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   frf->add_option("--output", a.output, "output: row of C, 1-based")->check(CLI::Range(1L, 1000000000L));
   frf->add_option("--from", a.from, "first frequency [Hz]")->check(frequency_hz());
   frf->add_option("--to", a.to, "last frequency [Hz]")->check(frequency_hz());
-  frf->add_option("--points", a.points, "number of frequencies")->check(CLI::Range(1L, 1000000000L));
+  frf->add_option("--points", a.points, "number of frequencies")->check(CLI::Range(1L, kMaxFrequencyPoints));
   frf->add_option("--spacing", a.spacing, "frequency spacing")
       ->check(CLI::IsMember({"log", "linear"}));
   frf->add_option("--method", a.method, "solution method")
@@ -129,6 +129,9 @@ int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
   } catch (const CLI::CallForHelp&) {
     out << app.help();
     return 0;
+  } catch (const CLI::CallForVersion& e) {
+    out << e.what() << "\n";
+    return 0;
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) {
       out << app.help();
@@ -137,17 +140,29 @@ int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) {
     err << "mbsgen linear: " << e.what() << "\n";
     return 2;
   }
-  if (frf->parsed() && a.spacing == "log" && (a.from <= 0 || a.to <= 0)) {
-    err << "mbsgen linear frf: --spacing log needs --from and --to > 0\n";
-    return 2;
+  if (frf->parsed()) {
+    const std::string problem = sweep_problem(a.from, a.to, a.points, a.spacing == "log");
+    if (!problem.empty()) {
+      err << "mbsgen linear frf: " << problem << "\n";
+      return 2;
+    }
   }
   try {
     if (modes->parsed()) return run_modes(c, all, out);
     return run_frf(c, a, out, err);
-  } catch (const Error& e) {
+  } catch (const NameError& e) {
+    err << "mbsgen linear: " << e.what() << "\n";
+    return 2;
+  } catch (const std::bad_alloc&) {
+    err << "mbsgen linear: error: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
     err << "mbsgen linear: error: " << e.what() << "\n";
     return 1;
   }
+} catch (const std::exception& e) {  // while setting up or parsing the command line
+  err << "mbsgen linear: error: " << e.what() << "\n";
+  return 1;
 }
 
 int linear_main(int argc, char** argv) { return linear_main(argc, argv, std::cout, std::cerr); }

@@ -1,2 +1,12 @@
+#include <exception>
+#include <iostream>
+
 #include "mbsgen/runtime/linear_cli.hpp"
-int main(int argc, char** argv) { return mbsgen::cli::linear_main(argc, argv); }
+
+// linear_main maps every exception to exit status 1 with a message; this is the last guard.
+int main(int argc, char** argv) try {
+  return mbsgen::cli::linear_main(argc, argv);
+} catch (const std::exception& e) {
+  std::cerr << "mbsgen linear: error: " << e.what() << "\n";
+  return 1;
+}

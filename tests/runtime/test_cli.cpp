@@ -43,9 +43,85 @@ TEST(MbsgenLinearCli, ExitCodesInProcess) {
   EXPECT_EQ(run({"linear", "modes", "--K", data + "K.mtx"}), 2);     // --M missing
   EXPECT_EQ(run({"linear", "frf", "--M", data + "M.mtx", "--K", data + "K.mtx", "--method", "x"}), 2);
   EXPECT_EQ(run({"linear", "modes", "--M", data + "nope.mtx", "--K", data + "K.mtx"}), 1);
-  EXPECT_EQ(run({"linear", "frf", "--M", data + "M.mtx", "--K", data + "K.mtx", "--input", "9"}), 1);
+  EXPECT_EQ(run({"linear", "frf", "--M", data + "M.mtx", "--K", data + "K.mtx", "--input", "9"}), 2);
   EXPECT_EQ(run({"linear", "frf", "--M", data + "M.mtx", "--K", data + "K.mtx", "--method", "modal",
                  "--Q", data + "Q.mtx", "--points", "3"}),
             0);
   EXPECT_EQ(run({"linear", "--help"}), 0);
+}
+
+namespace {
+
+struct LinearRun {
+  int rc;
+  std::string out, err;
+};
+
+LinearRun run_linear(std::vector<std::string> args) {
+  args.insert(args.begin(), "linear");
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  std::ostringstream out, err;
+  const int rc = mbsgen::cli::linear_main(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {rc, out.str(), err.str()};
+}
+
+}  // namespace
+
+// docs/cli.md: a value out of range is a usage error (2), as the solvers treat it; a reversed
+// range is refused with the solvers' message; --points has a documented limit.
+TEST(MbsgenLinearCli, UsageErrorsAndLimits) {
+  const std::string data = std::string(MBSGEN_SOURCE_DIR) + "/tests/runtime/data/";
+  const std::vector<std::string> mk = {"frf", "--M", data + "M.mtx", "--K", data + "K.mtx"};
+  auto with = [&mk](std::vector<std::string> more) {
+    std::vector<std::string> a = mk;
+    a.insert(a.end(), more.begin(), more.end());
+    return run_linear(a);
+  };
+  LinearRun r = with({"--output", "4"});
+  EXPECT_EQ(r.rc, 2);
+  EXPECT_EQ(r.err, "mbsgen linear: --output 4 out of range 1..3 (the rows of C)\n");
+  r = with({"--input", "4"});
+  EXPECT_EQ(r.rc, 2);
+  EXPECT_EQ(r.err, "mbsgen linear: --input 4 out of range 1..3 (the columns of B)\n");
+  r = with({"--from", "10", "--to", "1"});
+  EXPECT_EQ(r.rc, 2);
+  EXPECT_EQ(r.err, "mbsgen linear frf: empty range --from 10 --to 1 (--from must be below --to, or "
+                   "equal to it with --points 1)\n");
+  EXPECT_EQ(with({"--from", "5", "--to", "5"}).rc, 2);
+  r = with({"--from", "5", "--to", "5", "--points", "1"});
+  EXPECT_EQ(r.rc, 0) << r.err;
+  r = with({"--from", "0", "--to", "5"});
+  EXPECT_EQ(r.rc, 2);
+  EXPECT_EQ(r.err, "mbsgen linear frf: --spacing log needs --from and --to > 0 (got --from 0 --to 5)\n");
+  // kMaxFrequencyPoints = 1000000: one more is a usage error, before anything is allocated.
+  for (const char* points : {"1000001", "1e9", "1000000000"}) {
+    r = with({"--points", points});
+    EXPECT_EQ(r.rc, 2) << points;
+    EXPECT_NE(r.err.find("--points"), std::string::npos) << r.err;
+  }
+}
+
+TEST(MbsgenLinearCli, BadMatrixFilesExitWithStatus1AndTheFileAndLine) {
+  const std::string bad = std::string(MBSGEN_SOURCE_DIR) + "/tests/data/bad_matrices/";
+  const std::string data = std::string(MBSGEN_SOURCE_DIR) + "/tests/runtime/data/";
+  LinearRun r = run_linear({"modes", "--M", data + "M.mtx", "--K", bad + "symmetric_both_triangles.mtx"});
+  EXPECT_EQ(r.rc, 1);
+  EXPECT_EQ(r.err, "mbsgen linear: error: " + bad +
+                       "symmetric_both_triangles.mtx:6: entry (1,2) above the diagonal in a symmetric "
+                       "file: the format stores the lower triangle only (row >= column)\n");
+  r = run_linear({"modes", "--M", bad + "huge_declared_1e9.mtx", "--K", data + "K.mtx"});
+  EXPECT_EQ(r.rc, 1);
+  EXPECT_NE(r.err.find("huge_declared_1e9.mtx:3: a 1000000000x1000000000 matrix has 1e+18 entries"),
+            std::string::npos)
+      << r.err;
+  r = run_linear({"modes", "--M", "/dev/zero", "--K", data + "K.mtx"});
+  EXPECT_EQ(r.rc, 1);
+  EXPECT_EQ(r.err, "mbsgen linear: error: /dev/zero:1: a NUL byte: this is not a text file\n");
+}
+
+TEST(MbsgenLinearCli, VersionIsTheProjectVersion) {
+  const LinearRun r = run_linear({"--version"});
+  EXPECT_EQ(r.rc, 0);
+  EXPECT_EQ(r.out, std::string("mbsgen linear ") + MBSGEN_PROJECT_VERSION + "\n");
 }

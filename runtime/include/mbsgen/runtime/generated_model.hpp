@@ -44,6 +44,11 @@ struct ModelKernels {
                 double* K, double* B, double* Cy, double* Cv);
   int (*residual)(const double* y, const double* yd, const double* u, const double* p, double* r);
   int (*mass_matrix)(const double* y, const double* p, double* M);
+  // After the kernels, with defaults, so that a typed API generated before these fields existed
+  // still initialises the struct (and means: not recorded).
+  int default_points = 0;                   ///< the scene's number of frequencies (0: none given)
+  bool default_linear_spacing = false;      ///< the scene's spacing is linear (else logarithmic)
+  const char* generator_version = nullptr;  ///< mbsgen version that generated the kernels, or null
 };
 
 /// The first n entries of a kernel name array (null entries become "").

@@ -4,14 +4,31 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <iosfwd>
 #include <string>
 
 namespace mbsgen {
 
-/// Reads a real Matrix Market matrix from a file. Throws ParseError with "file:line: reason"
-/// (unsupported field such as complex or pattern, malformed line, index out of range, wrong
-/// entry count) and NonFiniteError for NaN/Inf entries. Duplicate coordinate entries are summed.
+/// Limits of the reader: matrices are read into dense storage, so a matrix may have at most
+/// kMatrixMarketMaxEntries entries (rows x columns, 200 MB of doubles; 5000 x 5000), checked
+/// against the size line before anything is allocated.
+inline constexpr long long kMatrixMarketMaxEntries = 25'000'000;
+/// The format's limit on the length of a line (characters, without the end of line).
+inline constexpr std::size_t kMatrixMarketMaxLine = 1024;
+/// At most this many blank or comment lines in a file, so that no input is read without end.
+inline constexpr long kMatrixMarketMaxBlankLines = 10'000;
+
+/// Reads a real Matrix Market matrix from a file. Throws ParseError with "file:line: reason" and
+/// NonFiniteError for NaN/Inf entries or values beyond double's range. Rules (docs/runtime.md):
+/// banner `%%MatrixMarket matrix array|coordinate real|integer general|symmetric|skew-symmetric`;
+/// comments only between the banner and the size line; one entry per line and nothing after it;
+/// `symmetric` stores the lower triangle (row >= column), `skew-symmetric` the strictly lower one
+/// (no diagonal); coordinate entries: 1-based indices within the size, each position at most once,
+/// exactly as many as declared (at most what the symmetry stores); integer fields hold integers.
+/// Lines are at most kMatrixMarketMaxLine characters, with no NUL byte; at most
+/// kMatrixMarketMaxBlankLines blank or comment lines. Memory and time are bounded by the size
+/// line: an endless or binary input ends in a ParseError.
 Eigen::MatrixXd read_matrix_market(const std::string& path);
 /// Same from a stream; `name` is used in error messages.
 Eigen::MatrixXd read_matrix_market(std::istream& in, const std::string& name);

@@ -7,3 +7,4 @@
 #include "mbsgen/runtime/matrix_market.hpp"
 #include "mbsgen/runtime/quadratic_eigen.hpp"
 #include "mbsgen/runtime/static_equilibrium.hpp"
+#include "mbsgen/runtime/version.hpp"
