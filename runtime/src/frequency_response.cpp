@@ -1,5 +1,6 @@
 #include "mbsgen/runtime/frequency_response.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -17,6 +18,7 @@ using RowMatrixXcd = Eigen::Matrix<cd, Eigen::Dynamic, Eigen::Dynamic, Eigen::Ro
 namespace {
 constexpr double kU = std::numeric_limits<double>::epsilon() / 2;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 
 /// Column j of a permuted-diagonal matrix X has its single nonzero val[j] in row row[j];
@@ -617,13 +619,19 @@ struct FrequencyResponse::Impl {
     return std::isfinite(rc) && rc >= threshold;
   }
 
-  void prepare_hessenberg(double mass_rcond, bool balance) {
-    if (hess_ready) return;
-    const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
+  /// Balancing job of the current reduction: 'B' (permute and scale), 'P' (permute) or 'N'.
+  char hess_job = 'N';
+  /// Largest backward error of the probe solves of the kept reduction (hessenberg_check), and
+  /// whether it met the bar.
+  double hess_backward_error = 0.0, hess_bar = 0.0;
+
+  /// Reduces the first-order form with the balancing `job` ('B', 'P' or 'N'): the standard form
+  /// A = [[0, E], [−M⁻¹K, −M⁻¹Q]] when rcond₁(M) ≥ mass_rcond, else the pencil.
+  void reduce_hessenberg(double mass_rcond, char job) {
+    const Eigen::MatrixXd &K = model.K(), &Q = model.Q();
     N = 2 * n;
-    const lapack_int NN = detail::li(N);
-    const char job = balance ? 'B' : 'N';
-    Mlu.compute(M);
+    hess_job = job;
+    Mlu.compute(model.M());
     hess_standard = mass_is_regular(mass_rcond);
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(N, N);
     A.topRightCorner(n, n).setIdentity();
@@ -632,70 +640,10 @@ struct FrequencyResponse::Impl {
       A.bottomRightCorner(n, n) = -Mlu.solve(Q);
       hess_standard = A.allFinite();
     }
-    if (hess_standard) {
-      hess_form = "standard";
-      Eigen::VectorXd scale(N);
-      lapack_int info = LAPACKE_dgebal(LAPACK_COL_MAJOR, job, NN, A.data(), NN, &hilo, &hihi,
-                                       scale.data());
-      detail::check_lapack(info, "dgebal", "FrequencyResponse (hessenberg)");
-      Eigen::MatrixXd I = Eigen::MatrixXd::Identity(N, N);
-      info = LAPACKE_dgebak(LAPACK_COL_MAJOR, job, 'R', NN, hilo, hihi, scale.data(), NN,
-                            I.data(), NN);
-      detail::check_lapack(info, "dgebak", "FrequencyResponse (hessenberg)");
-      Xr.from_dense(I);
-      I.setIdentity();
-      info = LAPACKE_dgebak(LAPACK_COL_MAJOR, job, 'L', NN, hilo, hihi, scale.data(), NN,
-                            I.data(), NN);
-      detail::check_lapack(info, "dgebak", "FrequencyResponse (hessenberg)");
-      Xl.from_dense(I);
-      hess_tau.resize(std::max<Index>(N - 1, 1));
-      info = LAPACKE_dgehrd(LAPACK_COL_MAJOR, NN, hilo, hihi, A.data(), NN, hess_tau.data());
-      detail::check_lapack(info, "dgehrd", "FrequencyResponse (hessenberg)");
-      H = A.triangularView<Eigen::Upper>();
-      for (Index i = 1; i < N; ++i) H(i, i - 1) = A(i, i - 1);
-      reflectors = std::move(A);
-    } else {
-      hess_form = "pencil";
-      A.setZero();
-      A.topRightCorner(n, n).setIdentity();
-      A.bottomLeftCorner(n, n) = -K;
-      A.bottomRightCorner(n, n) = -Q;
-      Eigen::MatrixXd E = Eigen::MatrixXd::Zero(N, N);
-      E.topLeftCorner(n, n).setIdentity();
-      E.bottomRightCorner(n, n) = M;
-      Eigen::VectorXd lscale(N), rscale(N);
-      lapack_int info = LAPACKE_dggbal(LAPACK_COL_MAJOR, job, NN, A.data(), NN, E.data(), NN,
-                                       &hilo, &hihi, lscale.data(), rscale.data());
-      detail::check_lapack(info, "dggbal", "FrequencyResponse (hessenberg)");
-      Eigen::MatrixXd I = Eigen::MatrixXd::Identity(N, N);
-      info = LAPACKE_dggbak(LAPACK_COL_MAJOR, job, 'R', NN, hilo, hihi, lscale.data(),
-                            rscale.data(), NN, I.data(), NN);
-      detail::check_lapack(info, "dggbak", "FrequencyResponse (hessenberg)");
-      Xr.from_dense(I);
-      I.setIdentity();
-      info = LAPACKE_dggbak(LAPACK_COL_MAJOR, job, 'L', NN, hilo, hihi, lscale.data(),
-                            rscale.data(), NN, I.data(), NN);
-      detail::check_lapack(info, "dggbak", "FrequencyResponse (hessenberg)");
-      Xl.from_dense(I);
-      // Triangularize E by QR, apply Qᵀ to A, then Hessenberg-triangular reduction (dgghrd).
-      qr_tau.resize(N);
-      info = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, NN, NN, E.data(), NN, qr_tau.data());
-      detail::check_lapack(info, "dgeqrf", "FrequencyResponse (hessenberg)");
-      info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', NN, NN, NN, E.data(), NN, qr_tau.data(),
-                            A.data(), NN);
-      detail::check_lapack(info, "dormqr", "FrequencyResponse (hessenberg)");
-      qr_E = E;
-      Eigen::MatrixXd R = E.triangularView<Eigen::Upper>();
-      Qleft.setIdentity(N, N);  // LAPACKE checks them for NaN even with compq = compz = 'I'
-      Zright.setIdentity(N, N);
-      info = LAPACKE_dgghrd(LAPACK_COL_MAJOR, 'I', 'I', NN, hilo, hihi, A.data(), NN, R.data(),
-                            NN, Qleft.data(), NN, Zright.data(), NN);
-      detail::check_lapack(info, "dgghrd", "FrequencyResponse (hessenberg)");
-      H = A;
-      for (Index j = 0; j < N; ++j)
-        for (Index i = j + 2; i < N; ++i) H(i, j) = 0.0;
-      T = R.triangularView<Eigen::Upper>();
-    }
+    if (hess_standard)
+      reduce_standard(std::move(A), job);
+    else
+      reduce_pencil(job);
     hsolver.resize(N);
     for (Index j = 0; j < N; ++j) {
       hsolver.colH[j] = H.col(j).cwiseAbs().sum();
@@ -703,11 +651,178 @@ struct FrequencyResponse::Impl {
     }
     xr_ws.resize(N);
     xi_ws.resize(N);
+  }
+
+  void reduce_standard(Eigen::MatrixXd&& A, char job) {
+    const lapack_int NN = detail::li(N);
+    hess_form = "standard";
+    Eigen::VectorXd scale(N);
+    lapack_int info = LAPACKE_dgebal(LAPACK_COL_MAJOR, job, NN, A.data(), NN, &hilo, &hihi,
+                                     scale.data());
+    detail::check_lapack(info, "dgebal", "FrequencyResponse (hessenberg)");
+    Eigen::MatrixXd I = Eigen::MatrixXd::Identity(N, N);
+    info = LAPACKE_dgebak(LAPACK_COL_MAJOR, job, 'R', NN, hilo, hihi, scale.data(), NN, I.data(),
+                          NN);
+    detail::check_lapack(info, "dgebak", "FrequencyResponse (hessenberg)");
+    Xr.from_dense(I);
+    I.setIdentity();
+    info = LAPACKE_dgebak(LAPACK_COL_MAJOR, job, 'L', NN, hilo, hihi, scale.data(), NN, I.data(),
+                          NN);
+    detail::check_lapack(info, "dgebak", "FrequencyResponse (hessenberg)");
+    Xl.from_dense(I);
+    hess_tau.resize(std::max<Index>(N - 1, 1));
+    info = LAPACKE_dgehrd(LAPACK_COL_MAJOR, NN, hilo, hihi, A.data(), NN, hess_tau.data());
+    detail::check_lapack(info, "dgehrd", "FrequencyResponse (hessenberg)");
+    H = A.triangularView<Eigen::Upper>();
+    for (Index i = 1; i < N; ++i) H(i, i - 1) = A(i, i - 1);
+    reflectors = std::move(A);
+  }
+
+  void reduce_pencil(char job) {
+    const lapack_int NN = detail::li(N);
+    hess_form = "pencil";
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(N, N);
+    A.topRightCorner(n, n).setIdentity();
+    A.bottomLeftCorner(n, n) = -model.K();
+    A.bottomRightCorner(n, n) = -model.Q();
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(N, N);
+    E.topLeftCorner(n, n).setIdentity();
+    E.bottomRightCorner(n, n) = model.M();
+    Eigen::VectorXd lscale(N), rscale(N);
+    lapack_int info = LAPACKE_dggbal(LAPACK_COL_MAJOR, job, NN, A.data(), NN, E.data(), NN,
+                                     &hilo, &hihi, lscale.data(), rscale.data());
+    detail::check_lapack(info, "dggbal", "FrequencyResponse (hessenberg)");
+    Eigen::MatrixXd I = Eigen::MatrixXd::Identity(N, N);
+    info = LAPACKE_dggbak(LAPACK_COL_MAJOR, job, 'R', NN, hilo, hihi, lscale.data(),
+                          rscale.data(), NN, I.data(), NN);
+    detail::check_lapack(info, "dggbak", "FrequencyResponse (hessenberg)");
+    Xr.from_dense(I);
+    I.setIdentity();
+    info = LAPACKE_dggbak(LAPACK_COL_MAJOR, job, 'L', NN, hilo, hihi, lscale.data(),
+                          rscale.data(), NN, I.data(), NN);
+    detail::check_lapack(info, "dggbak", "FrequencyResponse (hessenberg)");
+    Xl.from_dense(I);
+    // Triangularize E by QR, apply Qᵀ to A, then Hessenberg-triangular reduction (dgghrd).
+    qr_tau.resize(N);
+    info = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, NN, NN, E.data(), NN, qr_tau.data());
+    detail::check_lapack(info, "dgeqrf", "FrequencyResponse (hessenberg)");
+    info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', NN, NN, NN, E.data(), NN, qr_tau.data(),
+                          A.data(), NN);
+    detail::check_lapack(info, "dormqr", "FrequencyResponse (hessenberg)");
+    qr_E = E;
+    Eigen::MatrixXd R = E.triangularView<Eigen::Upper>();
+    Qleft.setIdentity(N, N);  // LAPACKE checks them for NaN even with compq = compz = 'I'
+    Zright.setIdentity(N, N);
+    info = LAPACKE_dgghrd(LAPACK_COL_MAJOR, 'I', 'I', NN, hilo, hihi, A.data(), NN, R.data(), NN,
+                          Qleft.data(), NN, Zright.data(), NN);
+    detail::check_lapack(info, "dgghrd", "FrequencyResponse (hessenberg)");
+    H = A;
+    for (Index j = 0; j < N; ++j)
+      for (Index i = j + 2; i < N; ++i) H(i, j) = 0.0;
+    T = R.triangularView<Eigen::Upper>();
+  }
+
+  /// Backward error, in the second-order system scaled to unit coordinates, of the Hessenberg
+  /// solution at Ω for the current input b (FrfOptions::hessenberg_backward_error_bar), with ŷ
+  /// the first n entries of x = Xr·(Q or Z)·x̃ (the reduction undone). +∞ at an exact zero pivot
+  /// or a non-finite solution. O(N²), about two frequencies' worth.
+  double hessenberg_backward_error(double om) {
+    const lapack_int NN = detail::li(N);
+    Eigen::MatrixXd X(N, 2);
+    Eigen::VectorXd xr = reduced_rhs(), xi = Eigen::VectorXd::Zero(N);
+    double rc = 0.0;
+    if (!hsolver.solve(H, hess_standard ? nullptr : &T, om, xr, xi, rc)) return kInf;
+    X << xr, xi;
+    if (hess_standard) {
+      const lapack_int info = LAPACKE_dormhr(LAPACK_COL_MAJOR, 'L', 'N', NN, 2, hilo, hihi,
+                                             reflectors.data(), NN, hess_tau.data(), X.data(), NN);
+      detail::check_lapack(info, "dormhr", "FrequencyResponse (hessenberg)");
+    } else {
+      X = (Zright * X).eval();
+    }
+    Eigen::VectorXcd yh(n);
+    for (Index j = 0; j < N; ++j) {
+      const Index i = Xr.row[static_cast<std::size_t>(j)];
+      if (i < n) yh[i] = Xr.val[j] * cd(X(j, 0), X(j, 1));
+    }
+    const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
+    const Eigen::VectorXd yr = yh.real(), yi = yh.imag();
+    const Eigen::VectorXd Kr = K * yr - om * om * (M * yr) - om * (Q * yi);
+    const Eigen::VectorXd Ki = K * yi - om * om * (M * yi) + om * (Q * yr);
+    // Normwise after the symmetric diagonal scaling S = diag(d)^(−1/2), d_i = |K_ii| + Ω²|M_ii|
+    // + Ω|Q_ii| (1 where all three vanish): D̃ = SDS, ỹ = S⁻¹ŷ, b̃ = Sb, so that the units of
+    // the coordinates (m, rad) do not decide it, as they would ‖·‖ of the unscaled system.
+    Eigen::VectorXd sc(n);
+    for (Index i = 0; i < n; ++i) {
+      const double d = std::abs(K(i, i)) + om * om * std::abs(M(i, i)) + om * std::abs(Q(i, i));
+      sc[i] = d > 0 ? 1.0 / std::sqrt(d) : 1.0;
+    }
+    double res = 0.0, dnorm = 0.0, ynorm = 0.0, bnorm = 0.0;
+    for (Index i = 0; i < n; ++i) {
+      res = std::max(res, sc[i] * std::abs(cd(b[i] - Kr[i], -Ki[i])));
+      double row = 0.0;
+      for (Index j = 0; j < n; ++j)
+        row += std::abs(cd(K(i, j) - om * om * M(i, j), om * Q(i, j))) * sc[j];
+      dnorm = std::max(dnorm, sc[i] * row);
+      ynorm = std::max(ynorm, std::abs(yh[i]) / sc[i]);
+      bnorm = std::max(bnorm, sc[i] * std::abs(b[i]));
+    }
+    const double den = dnorm * ynorm + bnorm;
+    const double eta = den > 0 ? res / den : (res == 0.0 ? 0.0 : kInf);
+    return std::isfinite(eta) ? eta : kInf;
+  }
+
+  /// Largest hessenberg_backward_error over up to five probe frequencies: the smallest, the
+  /// quartiles and the largest of `omega` (or Ω = √(‖K‖_F/‖M‖_F) when omega is empty).
+  double hessenberg_check(const Eigen::VectorXd& omega) {
+    std::vector<double> w(omega.data(), omega.data() + omega.size());
+    std::sort(w.begin(), w.end());
+    std::vector<double> probes;
+    const std::size_t F = w.size();
+    if (F == 0) {
+      const double g = std::sqrt(model.K().norm() / model.M().norm());
+      probes.push_back(std::isfinite(g) ? g : 1.0);
+    }
+    for (std::size_t q = 0; F > 0 && q <= 4; ++q) {
+      const double v = w[(F - 1) * q / 4];
+      if (probes.empty() || probes.back() != v) probes.push_back(v);
+    }
+    double eta = 0.0;
+    for (double om : probes) eta = std::max(eta, hessenberg_backward_error(om));
+    return eta;
+  }
+
+  /// The reduction with balancing chosen a posteriori (as QuadraticEigenSolver does): permute
+  /// and scale ('B'); when the largest backward error of the probe solves exceeds
+  /// FrfOptions::hessenberg_backward_error_bar, permute only ('P') and keep whichever is smaller.
+  /// balance == false: neither ('N').
+  void prepare_hessenberg(const FrfOptions& opt, const Eigen::VectorXd& omega) {
+    if (hess_ready) return;
+    const double bar = opt.hessenberg_backward_error_bar > 0
+                           ? opt.hessenberg_backward_error_bar
+                           : 10.0 * static_cast<double>(n) * kU;
+    hess_bar = bar;
+    if (!opt.balance) {
+      reduce_hessenberg(opt.hessenberg_mass_rcond, 'N');
+      hess_backward_error = hessenberg_check(omega);
+    } else {
+      reduce_hessenberg(opt.hessenberg_mass_rcond, 'B');
+      hess_backward_error = hessenberg_check(omega);
+            if (!(hess_backward_error <= bar)) {
+        const double eta_b = hess_backward_error;
+        reduce_hessenberg(opt.hessenberg_mass_rcond, 'P');
+        hess_backward_error = hessenberg_check(omega);
+        if (!(hess_backward_error < eta_b)) {
+          reduce_hessenberg(opt.hessenberg_mass_rcond, 'B');
+          hess_backward_error = eta_b;
+        }
+      }
+    }
     hess_ready = true;
   }
 
-  /// Reduced right-hand side and outputs for the current input/outputs.
-  void select_hessenberg() {
+  /// The right-hand side [0; b] (pencil) or [0; M⁻¹b] (standard form), balanced and reduced.
+  Eigen::VectorXd reduced_rhs() const {
     const lapack_int NN = detail::li(N);
     Eigen::VectorXd bx = Eigen::VectorXd::Zero(N);
     if (hess_standard)
@@ -715,30 +830,40 @@ struct FrequencyResponse::Impl {
     else
       bx.tail(n) = b;
     Eigen::VectorXd r = Xl.transpose_times(bx);
+    if (hess_standard) {
+      const lapack_int info =
+          LAPACKE_dormhr(LAPACK_COL_MAJOR, 'L', 'T', NN, 1, hilo, hihi, reflectors.data(), NN,
+                         hess_tau.data(), r.data(), NN);
+      detail::check_lapack(info, "dormhr", "FrequencyResponse (hessenberg)");
+    } else {
+      const lapack_int info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', NN, 1, NN, qr_E.data(),
+                                             NN, qr_tau.data(), r.data(), NN);
+      detail::check_lapack(info, "dormqr", "FrequencyResponse (hessenberg)");
+      r = Qleft.transpose() * r;
+    }
+    return r;
+  }
+
+  /// Reduced right-hand side and outputs for the current input/outputs.
+  void select_hessenberg() {
+    const lapack_int NN = detail::li(N);
     const Index p = Cy.rows();
     Eigen::MatrixXd Cx(p, N);  // first-order outputs z = [C_y, C_v] x
     Cx << Cy.real(), Cv.real();
     Eigen::MatrixXd Ct(N, p);  // (C_x Xr)ᵀ
     for (Index k = 0; k < p; ++k) Ct.col(k) = Xr.transpose_times(Cx.row(k).transpose());
     if (hess_standard) {
-      lapack_int info =
-          LAPACKE_dormhr(LAPACK_COL_MAJOR, 'L', 'T', NN, 1, hilo, hihi, reflectors.data(), NN,
-                         hess_tau.data(), r.data(), NN);
-      detail::check_lapack(info, "dormhr", "FrequencyResponse (hessenberg)");
       if (p > 0) {
-        info = LAPACKE_dormhr(LAPACK_COL_MAJOR, 'L', 'T', NN, detail::li(p), hilo, hihi,
-                              reflectors.data(), NN, hess_tau.data(), Ct.data(), NN);
+        const lapack_int info =
+            LAPACKE_dormhr(LAPACK_COL_MAJOR, 'L', 'T', NN, detail::li(p), hilo, hihi,
+                           reflectors.data(), NN, hess_tau.data(), Ct.data(), NN);
         detail::check_lapack(info, "dormhr", "FrequencyResponse (hessenberg)");
       }
     } else {
-      lapack_int info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', NN, 1, NN, qr_E.data(), NN,
-                                       qr_tau.data(), r.data(), NN);
-      detail::check_lapack(info, "dormqr", "FrequencyResponse (hessenberg)");
-      r = Qleft.transpose() * r;
       Ct = Zright.transpose() * Ct;
     }
     Chat_re = Ct.transpose();
-    rhs_reduced = r;
+    rhs_reduced = reduced_rhs();
     zr_ws.resize(p);
     zi_ws.resize(p);
   }
@@ -872,6 +997,7 @@ struct FrequencyResponse::Impl {
   // ---- real formulation (DESIGN.md §2) ----
   bool real_ready = false;
   Eigen::MatrixXd A1, A2, S, G;
+  Eigen::VectorXd req, ceq;  // equilibration of Ω²E + A² (dgeequb)
   Eigen::VectorXd Ab;
   std::vector<lapack_int> ipiv_r;
   Eigen::VectorXd dwork;
@@ -894,6 +1020,8 @@ struct FrequencyResponse::Impl {
     A2.noalias() = A1 * A1;
     S.resize(N, N);
     G.resize(N, 2);
+    req.resize(N);
+    ceq.resize(N);
     ipiv_r.resize(static_cast<std::size_t>(N));
     dwork.resize(4 * N);
     iwork.resize(static_cast<std::size_t>(N));
@@ -911,6 +1039,19 @@ struct FrequencyResponse::Impl {
   bool point_real(double om, double& rc) {
     S = A2;
     S.diagonal().array() += om * om;
+    // Equilibrate (dgeequ: row and column scalings by powers of the radix, exact): A² carries
+    // the squared spread of the model's scales (1e20 on ear-scaled models), and the rcond of the
+    // unscaled matrix measured that, not the conditioning of the solve.
+    double rowcnd = 0.0, colcnd = 0.0, amax = 0.0;
+    const lapack_int NE = detail::li(N);
+    const lapack_int einfo = LAPACKE_dgeequb_work(LAPACK_COL_MAJOR, NE, NE, S.data(), NE,
+                                                  req.data(), ceq.data(), &rowcnd, &colcnd, &amax);
+    if (einfo != 0) {  // an exactly zero row or column: singular
+      rc = 0.0;
+      return false;
+    }
+    S.array().colwise() *= req.array();
+    S.array().rowwise() *= ceq.array().transpose();
     double anorm = 0.0;
     for (Index j = 0; j < N; ++j) anorm = std::max(anorm, S.col(j).cwiseAbs().sum());
     const lapack_int NN = detail::li(N);
@@ -923,11 +1064,12 @@ struct FrequencyResponse::Impl {
     info = LAPACKE_dgecon_work(LAPACK_COL_MAJOR, '1', NN, S.data(), NN, anorm, &rc, dwork.data(),
                                iwork.data());
     detail::check_lapack(info, "dgecon", "FrequencyResponse (real)");
-    G.col(0) = Ab;
-    G.col(1) = -om * rhs_reduced;
+    G.col(0) = req.cwiseProduct(Ab);
+    G.col(1) = -om * req.cwiseProduct(rhs_reduced);
     info = LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', NN, 2, S.data(), NN, ipiv_r.data(),
                                G.data(), NN);
     detail::check_lapack(info, "dgetrs", "FrequencyResponse (real)");
+    G.array().colwise() *= ceq.array();
     gc.real() = G.col(0);
     gc.imag() = G.col(1);
     z.noalias() = Cxc * gc;
@@ -939,6 +1081,14 @@ FrequencyResponse::FrequencyResponse(const LinearModel& model, FrfOptions option
     : model_(model), options_(options), impl_(std::make_unique<Impl>(model)) {}
 
 FrequencyResponse::~FrequencyResponse() = default;
+
+char FrequencyResponse::hessenberg_balancing() const {
+  return impl_->hess_ready ? impl_->hess_job : '\0';
+}
+
+double FrequencyResponse::hessenberg_backward_error() const {
+  return impl_->hess_ready ? impl_->hess_backward_error : 0.0;
+}
 
 FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Index input,
                                               const std::vector<Index>& outputs) {
@@ -991,8 +1141,24 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
       im.select_banded();
       break;
     case FrfMethod::hessenberg:
-      im.prepare_hessenberg(options_.hessenberg_mass_rcond, options_.balance);
-      im.select_hessenberg();
+      im.prepare_hessenberg(options_, omega);
+      if (!(im.hess_backward_error <= im.hess_bar)) {
+        std::ostringstream s;
+        s << "FrequencyResponse (hessenberg): backward error " << im.hess_backward_error
+          << " at the probe frequencies exceeds " << im.hess_bar << " (balancing '" << im.hess_job
+          << "' kept)";
+        if (options_.method == FrfMethod::automatic) {
+          s << "; automatic uses direct";
+          used_ = m = FrfMethod::direct;
+          im.prepare_direct();
+        } else {
+          s << "; expect that many fewer correct digits than direct";
+          im.select_hessenberg();
+        }
+        warnings_.push_back(s.str());
+      } else {
+        im.select_hessenberg();
+      }
       break;
     case FrfMethod::modal:
       im.prepare_modal(options_, warnings_);
@@ -1025,7 +1191,10 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
     }
     rcond_[k] = rc;
     FrfFlag flag = FrfFlag::ok;
-    if (!ok || !(rc > pole_rc) || !im.z.allFinite())
+    // `real` solves the squared system Ω²E + A², whose rcond is about the square of the complex
+    // one's: a small rcond there says the real 2f×2f solve is ill-conditioned, not that Ω is a
+    // pole; a pole is an exact zero pivot or a non-finite value.
+    if (!ok || !im.z.allFinite() || (!(rc > pole_rc) && m != FrfMethod::real))
       flag = FrfFlag::pole;
     else if (rc < options_.ill_conditioned_rcond)
       flag = FrfFlag::ill_conditioned;

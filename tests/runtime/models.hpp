@@ -167,4 +167,93 @@ inline Qep ziegler(double P) {
   return p;
 }
 
+/// Skew matrix [r]× with [r]× v = r × v.
+inline Eigen::Matrix3d skew(const Eigen::Vector3d& r) {
+  Eigen::Matrix3d S;
+  S << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
+  return S;
+}
+
+/// An ossicular-chain-like model of 18 coordinates (issue 14 §2): three rigid bodies (malleus,
+/// incus, stapes), each with displacement u and small rotation θ (coordinates 6i..6i+5: u_x, u_y,
+/// u_z, θ_x, θ_y, θ_z), masses 1e-6..3e-5 kg, principal inertias m·(0.3..0.6 mm)², point masses at
+/// the umbo (on body 0) and the footplate (on body 2), and six 6-component bushings (three to
+/// the ground, two joints between the bodies, one more to the ground) at points offset by
+/// fractions of a millimetre, translational stiffness 1e2..1e4 N/m, rotational k·(0.5 mm)²,
+/// damping ratios of about 0.1. The velocity of a point r of body i is S(r) q_i with
+/// S(r) = [E, −[r]×]; a bushing between points r_a of body a and r_b of body b adds Gᵀ diag(k) G
+/// (and the same with c) with G = [[S(r_a), −S(r_b)], [0 E, 0 −E]] on the coordinates of a, b.
+/// Many entries of M, Q, K are exactly zero (diagonal principal inertias, offsets with zero
+/// components, bodies that share no bushing).
+inline Qep ossicle_like() {
+  const int n = 18;
+  Qep p{Eigen::MatrixXd::Zero(n, n), Eigen::MatrixXd::Zero(n, n), Eigen::MatrixXd::Zero(n, n)};
+  auto S = [](const Eigen::Vector3d& r) {
+    Eigen::Matrix<double, 3, 6> s;
+    s << Eigen::Matrix3d::Identity(), -skew(r);
+    return s;
+  };
+  const double mass[3] = {2.3e-5, 2.7e-5, 3.0e-6};
+  const double arm[3] = {6e-4, 5e-4, 3e-4};
+  for (int i = 0; i < 3; ++i) {
+    p.M.block(6 * i, 6 * i, 3, 3) = mass[i] * Eigen::Matrix3d::Identity();
+    const double J = mass[i] * arm[i] * arm[i];
+    p.M.block(6 * i + 3, 6 * i + 3, 3, 3) = Eigen::Vector3d(J, 0.7 * J, 0.4 * J).asDiagonal();
+  }
+  auto point_mass = [&](int body, double m, const Eigen::Vector3d& r) {
+    const Eigen::Matrix<double, 3, 6> s = S(r);
+    p.M.block(6 * body, 6 * body, 6, 6) += m * s.transpose() * s;
+  };
+  point_mass(0, 1.0e-6, Eigen::Vector3d(0, -4e-3, 0));   // umbo
+  point_mass(2, 1.5e-6, Eigen::Vector3d(0, 0, -1e-3));   // footplate
+  // body b < 0: ground.
+  auto bushing = [&](int a, const Eigen::Vector3d& ra, int b, const Eigen::Vector3d& rb,
+                     const Eigen::Vector3d& kt, double cscale) {
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(6, n);
+    G.block(0, 6 * a, 3, 6) = S(ra);
+    G.block(3, 6 * a + 3, 3, 3).setIdentity();
+    if (b >= 0) {
+      G.block(0, 6 * b, 3, 6) = -S(rb);
+      G.block(3, 6 * b + 3, 3, 3) = -Eigen::Matrix3d::Identity();
+    }
+    const double l2 = 0.25e-6;  // (0.5 mm)²
+    Eigen::VectorXd k(6), c(6);
+    k << kt, kt * l2;
+    c = cscale * k;
+    p.K += G.transpose() * k.asDiagonal() * G;
+    p.Q += G.transpose() * c.asDiagonal() * G;
+  };
+  const double cs = 2e-6;  // c = 2e-6 s · k: ζ ≈ ½ω·2e-6 ≈ 0.1 near 10 kHz
+  bushing(0, Eigen::Vector3d(0, -3e-3, 0), -1, Eigen::Vector3d::Zero(), Eigen::Vector3d(2e3, 4e2, 8e2), cs);
+  bushing(0, Eigen::Vector3d(1e-3, 0, 0), -1, Eigen::Vector3d::Zero(), Eigen::Vector3d(1e2, 3e2, 1e2), cs);
+  bushing(0, Eigen::Vector3d(0, 1e-3, 5e-4), 1, Eigen::Vector3d(0, -1e-3, 0),
+          Eigen::Vector3d(1e4, 5e3, 8e3), cs);
+  bushing(1, Eigen::Vector3d(-1e-3, 0, 0), -1, Eigen::Vector3d::Zero(), Eigen::Vector3d(3e2, 1e2, 2e2), cs);
+  bushing(1, Eigen::Vector3d(0, -2e-3, 0), 2, Eigen::Vector3d(0, 0, 5e-4),
+          Eigen::Vector3d(4e3, 4e3, 1e4), cs);
+  bushing(2, Eigen::Vector3d(0, 0, -1e-3), -1, Eigen::Vector3d::Zero(), Eigen::Vector3d(1e3, 1e3, 3e3), cs);
+  return p;
+}
+
+/// The same matrices with every exact zero replaced by rounding-level noise, as kernels that
+/// evaluate identically-zero expressions produce (issue 14 §1: 6.6e-24 in a zero block of M,
+/// ±1e-16-level residue in K): entry (i, j) becomes ±(0.5..1)·1e-17·√(|A_ii A_jj|), and every
+/// seventh such entry a tiny absolute 6.6e-24 instead. Deterministic (Lcg).
+inline Qep with_noise_in_zeros(Qep p, std::uint64_t seed = 3) {
+  Lcg r(seed);
+  int count = 0;
+  for (Eigen::MatrixXd* A : {&p.M, &p.Q, &p.K}) {
+    const Eigen::MatrixXd D = *A;
+    for (Eigen::Index j = 0; j < A->cols(); ++j)
+      for (Eigen::Index i = 0; i < A->rows(); ++i) {
+        if (D(i, j) != 0.0) continue;
+        const double sign = r() < 0.5 ? -1.0 : 1.0;
+        const double mag = 0.5 + 0.5 * r();
+        (*A)(i, j) = (++count % 7 == 0) ? 6.6e-24
+                                        : sign * mag * 1e-17 * std::sqrt(std::abs(D(i, i) * D(j, j)));
+      }
+  }
+  return p;
+}
+
 }  // namespace testmodels

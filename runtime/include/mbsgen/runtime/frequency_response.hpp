@@ -34,7 +34,9 @@ FrfMethod parse_frf_method(const std::string& name);
 /// b² ≤ 16f; otherwise direct when f < 12; hessenberg when frequencies ≥ min(30, max(8, f/2)) and
 /// rcond₁(M̃)·rcond₁(K̃) ≥ 1e-8, with M̃, K̃ = S M S, S K S and S = diag(M)^(−1/2) (M or K
 /// singular fails the test); otherwise direct. Costs two LU factorizations of f×f matrices when
-/// it gets to the conditioning test, nothing otherwise.
+/// it gets to the conditioning test, nothing otherwise. This is the rule before the solve:
+/// FrequencyResponse with FrfMethod::automatic also takes direct when hessenberg's a-posteriori
+/// backward-error check fails (FrfOptions::hessenberg_backward_error_bar).
 FrfMethod automatic_frf_method(const LinearModel& model, Eigen::Index frequencies);
 
 /// What to do at (or numerically at) a pole of an undamped system.
@@ -46,8 +48,13 @@ enum class PoleHandling {
 /// Per-frequency status.
 enum class FrfFlag : unsigned char {
   ok,               ///< rcond ≥ FrfOptions::ill_conditioned_rcond
-  ill_conditioned,  ///< pole_rcond < rcond < ill_conditioned_rcond: value kept, few digits
-  pole              ///< exactly singular or rcond ≤ pole_rcond: no correct digits; value NaN
+  /// pole_rcond < rcond < ill_conditioned_rcond: value kept, few digits; for `real`, any rcond
+  /// below ill_conditioned_rcond (the real 2f×2f system Ω²E + A² squares the condition number:
+  /// its rcond says how well that solve is conditioned, not that Ω is a pole)
+  ill_conditioned,
+  /// exactly singular (zero pivot), a non-finite value, or (except `real`) rcond ≤ pole_rcond:
+  /// no correct digits; value NaN
+  pole
 };
 /// "ok", "ill_conditioned", "pole".
 const char* to_string(FrfFlag flag);
@@ -79,10 +86,22 @@ struct FrfOptions {
   /// M⁻¹ itself; dgebal + dgehrd, blocked and fast) when rcond₁(M) ≥ this; otherwise the
   /// pencil (diag(E, M), [[0, E], [−K, −Q]]) (dggbal + dgghrd).
   double hessenberg_mass_rcond = 1e-6;
-  /// hessenberg: balance (permute and scale, LAPACK xGEBAL/xGGBAL job 'B') before the
-  /// reduction. Without it the ear-scaled chain loses 6-7 digits (issue 3); kept switchable for
-  /// the benchmarks and tests that show it.
+  /// hessenberg: balance before the reduction, chosen a posteriori: permute and scale (LAPACK
+  /// xGEBAL/xGGBAL job 'B'), and when the largest normwise backward error of the solution at up
+  /// to five probe frequencies (the smallest, the quartiles and the largest of the first
+  /// compute(), for its input; O(f²) each) exceeds hessenberg_backward_error_bar, permute only ('P'),
+  /// keeping whichever has the smaller backward error. Without scaling the ear-scaled chain
+  /// loses 6-7 digits (issue 3); with it, rounding noise where M, Q, K have exact zeros can steer
+  /// the scaling to lose all of them (issue 14). false: neither ('N'), for the benchmarks and
+  /// tests that show it.
   bool balance = true;
+  /// hessenberg: the bar of the a-posteriori check above, on the normwise backward error of ŷ
+  /// in the second-order system scaled to unit coordinates, ‖S(b − Dŷ)‖∞/(‖SDS‖∞‖S⁻¹ŷ‖∞ +
+  /// ‖Sb‖∞), D = K − Ω²M + iΩQ, S = diag(|K_ii| + Ω²|M_ii| + Ω|Q_ii|)^(−1/2); 0 means the
+  /// default 10·f·u, within an order of magnitude of what direct (LU with partial pivoting)
+  /// achieves. When no balancing meets it, FrfMethod::automatic uses direct instead and an
+  /// explicit hessenberg records a warning.
+  double hessenberg_backward_error_bar = 0.0;
 };
 
 /// Frequency response for one input column and selected output rows, shaped like an Eigen
@@ -93,7 +112,8 @@ struct FrfOptions {
 /// Every frequency carries a reciprocal condition estimate rcond (1-norm) of the matrix actually
 /// solved: K − Ω²M + iΩQ (direct, banded: LAPACK xGECON/xGBCON, Higham's estimator), the reduced
 /// Hessenberg matrix iΩT − H of the balanced first-order system (hessenberg: the two-solve
-/// LINPACK estimator of Cline, Moler, Stewart & Wilkinson 1979), Ω²E + A² (real: dgecon);
+/// LINPACK estimator of Cline, Moler, Stewart & Wilkinson 1979), Ω²E + A² equilibrated by
+/// dgeequb (real: dgecon);
 /// for modal min(min_k |iΩ − λ_k|/max(|λ_k|, Ω), ‖ẑ‖/Σ_k‖term_k‖)/κ: the relative distance to
 /// the nearest pole and the cancellation in the modal sum, divided by the eigenvector condition κ. Amplitude |ẑ| and phase lag Ψ = −arg ẑ = atan2(−Im ẑ, Re ẑ), so that
 /// z(t) = |ẑ| cos(Ωt − Ψ) (eqs. 3.21-3.23 with the quadrant kept).
@@ -123,6 +143,12 @@ class FrequencyResponse {
   const Eigen::VectorXd& rcond() const { return rcond_; }
   /// F flags.
   const std::vector<FrfFlag>& flags() const { return flags_; }
+  /// hessenberg: the balancing the a-posteriori check kept, 'B' (permute and scale), 'P'
+  /// (permute) or 'N' (none); '\0' before the method has been set up.
+  char hessenberg_balancing() const;
+  /// hessenberg: the largest normwise backward error of the probe solves of that check
+  /// (FrfOptions::balance); 0 before the method has been set up.
+  double hessenberg_backward_error() const;
   /// Warnings recorded by the last compute() (e.g. modal without static correction).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
