@@ -623,7 +623,7 @@ struct FrequencyResponse::Impl {
   char hess_job = 'N';
   /// Largest backward error of the probe solves of the kept reduction (hessenberg_check), and
   /// whether it met the bar.
-  double hess_backward_error = 0.0, hess_bar = 0.0;
+  double hess_backward_error = 0.0, hess_bar = 0.0, hess_forward_ratio = 0.0;
 
   /// Reduces the first-order form with the balancing `job` ('B', 'P' or 'N'): the standard form
   /// A = [[0, E], [−M⁻¹K, −M⁻¹Q]] when rcond₁(M) ≥ mass_rcond, else the pencil.
@@ -726,12 +726,13 @@ struct FrequencyResponse::Impl {
   /// solution at Ω for the current input b (FrfOptions::hessenberg_backward_error_bar), with ŷ
   /// the first n entries of x = Xr·(Q or Z)·x̃ (the reduction undone). +∞ at an exact zero pivot
   /// or a non-finite solution. O(N²), about two frequencies' worth.
-  double hessenberg_backward_error(double om) {
+  /// ŷ at Ω by the Hessenberg reduction (the reduction undone); false at an exact zero pivot.
+  bool hessenberg_solution(double om, Eigen::VectorXcd& yh) {
     const lapack_int NN = detail::li(N);
     Eigen::MatrixXd X(N, 2);
     Eigen::VectorXd xr = reduced_rhs(), xi = Eigen::VectorXd::Zero(N);
     double rc = 0.0;
-    if (!hsolver.solve(H, hess_standard ? nullptr : &T, om, xr, xi, rc)) return kInf;
+    if (!hsolver.solve(H, hess_standard ? nullptr : &T, om, xr, xi, rc)) return false;
     X << xr, xi;
     if (hess_standard) {
       const lapack_int info = LAPACKE_dormhr(LAPACK_COL_MAJOR, 'L', 'N', NN, 2, hilo, hihi,
@@ -740,23 +741,78 @@ struct FrequencyResponse::Impl {
     } else {
       X = (Zright * X).eval();
     }
-    Eigen::VectorXcd yh(n);
+    yh.resize(n);
     for (Index j = 0; j < N; ++j) {
       const Index i = Xr.row[static_cast<std::size_t>(j)];
       if (i < n) yh[i] = Xr.val[j] * cd(X(j, 0), X(j, 1));
     }
+    return yh.allFinite();
+  }
+
+  /// Scaling of the coordinates to unit size at Ω: s_i = d_i^(−1/2), d_i = |K_ii| + Ω²|M_ii|
+  /// + Ω|Q_ii| (1 where all three vanish), so that units (m, rad) do not decide a norm.
+  Eigen::VectorXd unit_scaling(double om) const {
     const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
-    const Eigen::VectorXd yr = yh.real(), yi = yh.imag();
-    const Eigen::VectorXd Kr = K * yr - om * om * (M * yr) - om * (Q * yi);
-    const Eigen::VectorXd Ki = K * yi - om * om * (M * yi) + om * (Q * yr);
-    // Normwise after the symmetric diagonal scaling S = diag(d)^(−1/2), d_i = |K_ii| + Ω²|M_ii|
-    // + Ω|Q_ii| (1 where all three vanish): D̃ = SDS, ỹ = S⁻¹ŷ, b̃ = Sb, so that the units of
-    // the coordinates (m, rad) do not decide it, as they would ‖·‖ of the unscaled system.
     Eigen::VectorXd sc(n);
     for (Index i = 0; i < n; ++i) {
       const double d = std::abs(K(i, i)) + om * om * std::abs(M(i, i)) + om * std::abs(Q(i, i));
       sc[i] = d > 0 ? 1.0 / std::sqrt(d) : 1.0;
     }
+    return sc;
+  }
+
+  /// Forward errors at Ω, in the unit-scaled max norm: of direct (an LU with partial pivoting of
+  /// K − Ω²M + iΩQ, estimated by one step of iterative refinement, whose correction is that
+  /// error to first order) and of the Hessenberg solution against the refined direct one.
+  /// O(f³): used at the probe frequencies only, by FrfMethod::automatic.
+  std::pair<double, double> forward_errors(double om) {
+    Eigen::VectorXcd yh;
+    if (!hessenberg_solution(om, yh)) return {0.0, kInf};
+    const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
+    Eigen::MatrixXcd Dw(n, n);
+    for (Index j = 0; j < n; ++j)
+      for (Index i = 0; i < n; ++i) Dw(i, j) = cd(K(i, j) - om * om * M(i, j), om * Q(i, j));
+    const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(Dw);
+    const Eigen::VectorXcd bc = b.cast<cd>();
+    const Eigen::VectorXcd yd = lu.solve(bc);
+    const Eigen::VectorXcd dy = lu.solve(bc - Dw * yd);
+    const Eigen::VectorXcd ref = yd + dy;
+    const Eigen::VectorXd sc = unit_scaling(om);
+    double nref = 0.0, ed = 0.0, eh = 0.0;
+    for (Index i = 0; i < n; ++i) {
+      nref = std::max(nref, std::abs(ref[i]) / sc[i]);
+      ed = std::max(ed, std::abs(dy[i]) / sc[i]);
+      eh = std::max(eh, std::abs(yh[i] - ref[i]) / sc[i]);
+    }
+    if (!(nref > 0) || !std::isfinite(nref)) return {0.0, eh == 0.0 ? 0.0 : kInf};
+    return {ed / nref, eh / nref};
+  }
+
+  /// FrfMethod::automatic's accuracy check of hessenberg: true when at every probe frequency
+  /// its forward error is within 10× of direct's (or both below 10·f·u, rounding level).
+  bool hessenberg_as_accurate_as_direct(const Eigen::VectorXd& omega, double& worst_ratio) {
+    worst_ratio = 0.0;
+    const double floor = 10.0 * static_cast<double>(n) * kU;
+    bool ok = true;
+    for (double om : probe_frequencies(omega)) {
+      const auto [ed, eh] = forward_errors(om);
+      worst_ratio = std::max(worst_ratio, eh / std::max(ed, floor));
+      if (!(eh <= 10.0 * std::max(ed, floor))) ok = false;
+    }
+    return ok;
+  }
+
+  double hessenberg_backward_error(double om) {
+    Eigen::VectorXcd yh;
+    if (!hessenberg_solution(om, yh)) return kInf;
+    const Eigen::MatrixXd &M = model.M(), &Q = model.Q(), &K = model.K();
+    const Eigen::VectorXd yr = yh.real(), yi = yh.imag();
+    const Eigen::VectorXd Kr = K * yr - om * om * (M * yr) - om * (Q * yi);
+    const Eigen::VectorXd Ki = K * yi - om * om * (M * yi) + om * (Q * yr);
+    // Normwise after the symmetric diagonal scaling S = diag(unit_scaling): D̃ = SDS, ỹ = S⁻¹ŷ,
+    // b̃ = Sb, so that the units of the coordinates (m, rad) do not decide it, as they would
+    // ‖·‖ of the unscaled system.
+    const Eigen::VectorXd sc = unit_scaling(om);
     double res = 0.0, dnorm = 0.0, ynorm = 0.0, bnorm = 0.0;
     for (Index i = 0; i < n; ++i) {
       res = std::max(res, sc[i] * std::abs(cd(b[i] - Kr[i], -Ki[i])));
@@ -775,6 +831,12 @@ struct FrequencyResponse::Impl {
   /// Largest hessenberg_backward_error over up to five probe frequencies: the smallest, the
   /// quartiles and the largest of `omega` (or Ω = √(‖K‖_F/‖M‖_F) when omega is empty).
   double hessenberg_check(const Eigen::VectorXd& omega) {
+    double eta = 0.0;
+    for (double om : probe_frequencies(omega)) eta = std::max(eta, hessenberg_backward_error(om));
+    return eta;
+  }
+
+  std::vector<double> probe_frequencies(const Eigen::VectorXd& omega) const {
     std::vector<double> w(omega.data(), omega.data() + omega.size());
     std::sort(w.begin(), w.end());
     std::vector<double> probes;
@@ -787,9 +849,7 @@ struct FrequencyResponse::Impl {
       const double v = w[(F - 1) * q / 4];
       if (probes.empty() || probes.back() != v) probes.push_back(v);
     }
-    double eta = 0.0;
-    for (double om : probes) eta = std::max(eta, hessenberg_backward_error(om));
-    return eta;
+    return probes;
   }
 
   /// The reduction with balancing chosen a posteriori (as QuadraticEigenSolver does): permute
@@ -1142,7 +1202,15 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
       break;
     case FrfMethod::hessenberg:
       im.prepare_hessenberg(options_, omega);
-      if (!(im.hess_backward_error <= im.hess_bar)) {
+      if (options_.method == FrfMethod::automatic && im.hess_backward_error <= im.hess_bar &&
+          !im.hessenberg_as_accurate_as_direct(omega, im.hess_forward_ratio)) {
+        std::ostringstream s;
+        s << "FrequencyResponse (hessenberg): forward error " << im.hess_forward_ratio
+          << "x direct's at a probe frequency (bar 10x); automatic uses direct";
+        warnings_.push_back(s.str());
+        used_ = m = FrfMethod::direct;
+        im.prepare_direct();
+      } else if (!(im.hess_backward_error <= im.hess_bar)) {
         std::ostringstream s;
         s << "FrequencyResponse (hessenberg): backward error " << im.hess_backward_error
           << " at the probe frequencies exceeds " << im.hess_bar << " (balancing '" << im.hess_job
