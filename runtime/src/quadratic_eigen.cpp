@@ -85,6 +85,48 @@ const char* to_string(EigenvalueKind kind) {
   return "finite";
 }
 
+const char* to_string(Stability verdict) {
+  switch (verdict) {
+    case Stability::stable: return "stable";
+    case Stability::unstable: return "unstable";
+    case Stability::marginal: return "marginal";
+    case Stability::undecided: break;
+  }
+  return "undecided";
+}
+
+const char* kind_label(const Mode& mode) {
+  return mode.zero_within_bound ? "zero_within_bound" : to_string(mode.kind);
+}
+
+namespace {
+
+/// The verdict of Stability from the modes' error bounds; infinite eigenvalues do not count.
+Stability stability_verdict(const std::vector<Mode>& modes) {
+  bool undecided = false, on_axis = false;
+  for (const Mode& m : modes) {
+    if (m.kind == EigenvalueKind::infinite) continue;
+    if (m.kind == EigenvalueKind::zero) {
+      on_axis = true;
+      continue;
+    }
+    const double re = m.lambda.real();
+    if (m.zero_within_bound || !(m.error_bound < kInf)) {
+      undecided = true;
+    } else if (re > m.error_bound) {
+      return Stability::unstable;
+    } else if (re == 0.0) {
+      on_axis = true;
+    } else if (re >= -m.error_bound) {
+      undecided = true;
+    }
+  }
+  if (undecided) return Stability::undecided;
+  return on_axis ? Stability::marginal : Stability::stable;
+}
+
+}  // namespace
+
 double quadratic_backward_error(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
                                 const Eigen::MatrixXd& K, cd alpha, double beta,
                                 const Eigen::VectorXcd& x, double norm_M, double norm_Q,
@@ -149,10 +191,14 @@ QuadraticEigenSolver& QuadraticEigenSolver::compute(const Eigen::MatrixXd& M,
   tau_ = (fM > 0 && fK > 0) ? fQ / std::sqrt(fM * fK) : kInf;
   gamma_ = (fM > 0 && fK > 0) ? std::sqrt(fK / fM) : 1.0;
 
+  floor_ = options_.backward_error_floor > 0   ? options_.backward_error_floor
+           : options_.backward_error_floor == 0 ? 100.0 * static_cast<double>(n) * kU
+                                                : 0.0;
   bool done = false;
   if (options_.symmetric_fast_path && check.is_symmetric_undamped()) compute_symmetric(M, K, done);
   if (!done) compute_general(M, Qf, K);
   finish(M, Qf, K);
+  stability_ = stability_verdict(modes_);
   info_ = Eigen::Success;
   return *this;
 }
@@ -729,6 +775,15 @@ void QuadraticEigenSolver::finish(const Eigen::MatrixXd& M, const Eigen::MatrixX
         const cd d = y.dot(2.0 * lam * px.MX.col(k) + px.QX.col(k));
         const double num = (r * r * norm_M_ + r * norm_Q_ + norm_K_);
         md.condition = (r > 0 && std::abs(d) > 0) ? num / (r * std::abs(d)) : kInf;
+        // Absolute condition number times the backward error (not below the floor): a
+        // Jordan block at 0 split into ±√δ by rounding has yᴴ(2λM + Q)x = O(√δ), so its bound
+        // exceeds |λ| and it is reported zero within bound, without a damping ratio.
+        const double kappa_abs =
+            std::abs(d) > 0 ? num * xn * y.norm() / std::abs(d) : kInf;
+        const double eta = std::max(md.backward_error, floor_);
+        md.error_bound = kappa_abs < kInf ? kappa_abs * eta : kInf;
+        md.zero_within_bound = !(r > md.error_bound);
+        if (md.zero_within_bound) md.damping_ratio = std::numeric_limits<double>::quiet_NaN();
         break;
       }
     }

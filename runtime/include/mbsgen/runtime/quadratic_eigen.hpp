@@ -21,6 +21,24 @@ enum class EigenvalueKind {
 /// "finite", "zero" or "infinite".
 const char* to_string(EigenvalueKind kind);
 
+/// Verdict on the linear stability of M ÿ + Q ẏ + K y = 0 that takes each eigenvalue's
+/// error_bound into account (QuadraticEigenSolver::stability()). Infinite eigenvalues (massless
+/// coordinates, constraints) carry no motion and are not counted.
+enum class Stability {
+  stable,     ///< every finite eigenvalue has Re λ < −error_bound, and there is no zero one
+  unstable,   ///< some eigenvalue has Re λ > error_bound (and is not zero within its bound)
+  marginal,   ///< not unstable, and the eigenvalues not decided stable are exactly on the
+              ///< imaginary axis: deflated zeros (rigid-body modes) or Re λ = 0 exactly (the
+              ///< symmetric undamped path); growth then depends on Jordan structure and on
+              ///< nonlinear terms, which the linear analysis does not decide
+  undecided   ///< not unstable, but some eigenvalue is zero within its bound or has
+              ///< 0 < |Re λ| ≤ error_bound: perturbations of the data of the size behind the
+              ///< bound can move it to either half-plane
+};
+
+/// "stable", "unstable", "marginal" or "undecided".
+const char* to_string(Stability verdict);
+
 /// One eigenpair of λ²M + λQ + K.
 struct Mode {
   /// Reported eigenvalue λ (1/s): exactly 0 for kind zero, +∞ (real part) for kind infinite.
@@ -33,7 +51,8 @@ struct Mode {
   EigenvalueKind kind = EigenvalueKind::finite;
   double natural_frequency_hz = 0.0;  ///< |λ|/2π (Hz); 0 for zero, +∞ for infinite
   double damped_frequency_hz = 0.0;   ///< Im λ/2π (Hz)
-  /// −Re λ/|λ| (dimensionless); NaN for zero eigenvalues (undefined), 0 for infinite ones.
+  /// −Re λ/|λ| (dimensionless); NaN (undefined) for zero eigenvalues and for those zero within
+  /// their error bound, 0 for infinite ones.
   double damping_ratio = 0.0;
   /// Right eigenvector x (f), normalized to ‖x‖₂ = 1 with its largest-modulus entry real positive.
   Eigen::VectorXcd shape;
@@ -53,7 +72,22 @@ struct Mode {
   /// geometric one, e.g. the double λ = 0 of an undamped rigid-body mode): it has one eigenvector
   /// per chain, `shape` is that eigenvector (the chain's head), and both condition numbers are +∞.
   bool defective = false;
+  /// Absolute first-order error bound on λ (1/s): κ_abs(λ)·max(η, η_floor), with η =
+  /// backward_error, η_floor = QuadraticEigenOptions::backward_error_floor and the absolute
+  /// condition number κ_abs = (|λ|²‖M‖ + |λ|‖Q‖ + ‖K‖)‖x‖‖y‖ / |yᴴ(2λM + Q)x| (Tisseur 2000,
+  /// Thm. 5, = |λ|·condition). The exact eigenvalue of a problem within relative normwise distance
+  /// max(η, η_floor) of the data lies within error_bound of λ to first order. +∞ when
+  /// yᴴ(2λM + Q)x = 0 (a defective eigenvalue); 0 for the deflated zero and infinite kinds, whose
+  /// values are exact for the data perturbed by backward_error.
+  double error_bound = 0.0;
+  /// True for a finite eigenvalue with |λ| ≤ error_bound: the data do not separate it from 0
+  /// (e.g. a Jordan block at 0 with rounding noise, which QZ splits into ±√noise). λ is still
+  /// reported, but damping_ratio is NaN and the mode is neither stable nor unstable.
+  bool zero_within_bound = false;
 };
+
+/// "zero_within_bound" for a mode with zero_within_bound set, else to_string(kind).
+const char* kind_label(const Mode& mode);
 
 /// Options of QuadraticEigenSolver.
 struct QuadraticEigenOptions {
@@ -80,6 +114,12 @@ struct QuadraticEigenOptions {
   /// An eigenvalue is deflated only if a perturbation of that relative size makes it exactly 0 or
   /// ∞: a small but nonzero eigenvalue (a soft spring, a weak damper to ground) stays finite.
   double rank_tolerance = 0.0;
+  /// Relative normwise data uncertainty η_floor below which a backward error does not lower
+  /// Mode::error_bound; 0 means the default 100·f·u, the backward-error level the solver is
+  /// tested to (a matrix of f×f entries evaluated in floating point carries relative errors of
+  /// order f·u, with room for cancellation in generated kernels). Negative: no floor (the bound
+  /// then reflects the computed backward error alone).
+  double backward_error_floor = 0.0;
   /// Unused since zero and infinite eigenvalues are deflated exactly (see rank_tolerance); kept so
   /// that code setting it still compiles.
   double classification_tolerance = 1e-6;
@@ -138,6 +178,11 @@ class QuadraticEigenSolver {
   const std::string& method() const { return method_; }
   /// Largest backward error over all eigenpairs.
   double max_backward_error() const;
+  /// Stability verdict of the spectrum, each eigenvalue taken with its error_bound (see
+  /// Stability). With one_per_conjugate_pair the omitted members have the same real parts.
+  Stability stability() const { return stability_; }
+  /// The backward-error floor η_floor used for the error bounds (see backward_error_floor).
+  double backward_error_floor() const { return floor_; }
 
  private:
   void compute_symmetric(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K, bool& ok);
@@ -150,7 +195,8 @@ class QuadraticEigenSolver {
   std::vector<Mode> modes_;
   Eigen::Index rank_M_ = 0, rank_K_ = 0, num_zero_ = 0, num_infinite_ = 0;
   Eigen::MatrixXd null_M_, null_K_;
-  double tau_ = 0.0, gamma_ = 1.0;
+  double tau_ = 0.0, gamma_ = 1.0, floor_ = 0.0;
+  Stability stability_ = Stability::undecided;
   double norm_M_ = 0.0, norm_Q_ = 0.0, norm_K_ = 0.0;  // ‖·‖₂ lower estimates
   std::string method_;
   // Workspaces of the linearization (2f×2f) reused across compute() calls.
