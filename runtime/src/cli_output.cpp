@@ -7,7 +7,20 @@ namespace mbsgen::cli {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
+
+/// One line on what a verdict of QuadraticEigenSolver::stability() means.
+const char* stability_reason(Stability s) {
+  switch (s) {
+    case Stability::stable: return "every eigenvalue has Re lambda < -error_bound";
+    case Stability::unstable: return "an eigenvalue has Re lambda > error_bound";
+    case Stability::marginal:
+      return "none unstable; eigenvalues exactly on the imaginary axis (zero, or Re lambda = 0)";
+    case Stability::undecided: break;
+  }
+  return "none unstable; an eigenvalue is zero within its error bound or has "
+         "|Re lambda| <= error_bound";
 }
+}  // namespace
 
 // NaN marks a quantity that is undefined (the damping ratio of λ = 0): null in JSON, an empty
 // field in CSV, "-" in tables; never the string "nan".
@@ -87,8 +100,9 @@ void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::I
           << ",\"natural_frequency_hz\":" << num(m.natural_frequency_hz, true)
           << ",\"damped_frequency_hz\":" << num(m.damped_frequency_hz, true)
           << ",\"damping_ratio\":" << num(m.damping_ratio, true)
-          << ",\"backward_error\":" << num(m.backward_error, true) << ",\"kind\":\""
-          << to_string(m.kind) << "\"";
+          << ",\"backward_error\":" << num(m.backward_error, true)
+          << ",\"error_bound\":" << num(m.error_bound, true) << ",\"kind\":\"" << kind_label(m)
+          << "\"";
       if (f.shapes) {
         out << ",\"shape\":{";
         for (Eigen::Index i = 0; i < m.shape.size(); ++i)
@@ -98,10 +112,10 @@ void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::I
       }
       out << "}";
     }
-    out << "\n]}\n";
+    out << "\n],\"stability\":\"" << to_string(solver.stability()) << "\"}\n";
   } else if (f.format == "csv") {
     out << "lambda_re,lambda_im,natural_frequency_hz,damped_frequency_hz,damping_ratio,"
-           "backward_error,kind";
+           "backward_error,error_bound,kind";
     if (f.shapes)
       for (Eigen::Index i = 0; i < size; ++i) out << "," << coordinate(i) << "_re," << coordinate(i) << "_im";
     out << "\n";
@@ -109,7 +123,7 @@ void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::I
       out << num(m.lambda.real(), false) << "," << num(m.lambda.imag(), false) << ","
           << num(m.natural_frequency_hz, false) << "," << num(m.damped_frequency_hz, false)
           << "," << num(m.damping_ratio, false) << "," << num(m.backward_error, false) << ","
-          << to_string(m.kind);
+          << num(m.error_bound, false) << "," << kind_label(m);
       if (f.shapes)
         for (Eigen::Index i = 0; i < m.shape.size(); ++i)
           out << "," << num(m.shape[i].real(), false) << "," << num(m.shape[i].imag(), false);
@@ -117,15 +131,19 @@ void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::I
     }
   } else {
     out << pad("#", 4) << pad("lambda_re", 15) << pad("lambda_im", 15) << pad("f_n [Hz]", 15)
-        << pad("f_d [Hz]", 15) << pad("zeta", 15) << pad("backward_err", 15) << "  kind\n";
+        << pad("f_d [Hz]", 15) << pad("zeta", 15) << pad("backward_err", 15)
+        << pad("error_bound", 15) << "  kind\n";
     int k = 1;
     for (const Mode& m : modes)
       out << pad(std::to_string(k++), 4) << pad(short_num(m.lambda.real()), 15)
           << pad(short_num(m.lambda.imag()), 15) << pad(short_num(m.natural_frequency_hz), 15)
           << pad(short_num(m.damped_frequency_hz), 15) << pad(short_num(m.damping_ratio), 15)
-          << pad(short_num(m.backward_error), 15) << "  " << to_string(m.kind) << "\n";
+          << pad(short_num(m.backward_error), 15) << pad(short_num(m.error_bound), 15) << "  "
+          << kind_label(m) << "\n";
     out << "# method " << solver.method() << ", rank M " << solver.rank_M() << "/" << size
         << ", rank K " << solver.rank_K() << "/" << size << "\n";
+    out << "# stability " << to_string(solver.stability()) << ": "
+        << stability_reason(solver.stability()) << "\n";
     if (f.shapes) {
       out << "# mode shapes (unit 2-norm, largest entry real positive): amplitude, phase [deg]\n";
       out << pad("coordinate", 16);

@@ -2,6 +2,8 @@
 // tests/runtime/data and compares the output; plus exit-code checks through linear_main.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -124,4 +126,94 @@ TEST(MbsgenLinearCli, VersionIsTheProjectVersion) {
   const LinearRun r = run_linear({"--version"});
   EXPECT_EQ(r.rc, 0);
   EXPECT_EQ(r.out, std::string("mbsgen linear ") + MBSGEN_PROJECT_VERSION + "\n");
+}
+
+// Out of memory is a message and exit status 1, not an abort: three 5000 x 5000 matrices (the
+// reader's limit, 200 MB each, from one-entry files) under a 500 MB address-space limit. The
+// same limit leaves room for a small model (the process itself maps about 190 MB, OpenBLAS's
+// buffers included; OpenBLAS hangs at start when its threads cannot get theirs, hence one thread).
+TEST(MbsgenLinearCli, OutOfMemoryIsAMessageAndStatus1) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no ulimit -v";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no ulimit -v";
+#endif
+#endif
+  const std::string dir = ::testing::TempDir();
+  const std::string big = dir + "mbsgen_oom_5000.mtx";
+  std::ofstream(big) << "%%MatrixMarket matrix coordinate real general\n5000 5000 1\n1 1 1.0\n";
+  const std::string data = std::string(MBSGEN_SOURCE_DIR) + "/tests/runtime/data/";
+  auto run = [](const std::string& args, std::string* output) {
+    const std::string command = "ulimit -v 500000 && OPENBLAS_NUM_THREADS=1 exec timeout 60 '" +
+                                std::string(MBSGEN_LINEAR_EXE) + "' " + args + " 2>&1";
+    FILE* p = ::popen(command.c_str(), "r");
+    if (!p) return -1;
+    char buf[512];
+    output->clear();
+    while (std::fgets(buf, sizeof buf, p)) *output += buf;
+    const int status = ::pclose(p);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  };
+  std::string text;
+  EXPECT_EQ(run("modes --M " + data + "M.mtx --K " + data + "K.mtx", &text), 0) << text;
+  EXPECT_EQ(run("modes --M " + big + " --K " + big + " --Q " + big, &text), 1) << text;
+  EXPECT_EQ(text, "mbsgen linear: error: out of memory\n");
+  std::remove(big.c_str());
+}
+
+// Issue 14 §2: a Jordan block at λ = 0 with rounding noise in K (Kjordan_noisy.mtx: QZ splits it
+// into ±5.7e-7 1/s) is shown as zero within its error bound, with no damping ratio (it used to
+// read as a stable and an unstable real mode, zeta ±1), and the verdict is not "unstable".
+TEST(MbsgenLinearCli, NoisyJordanBlockAtZeroIsShownZeroWithinBound) {
+  const std::string data = std::string(MBSGEN_SOURCE_DIR) + "/tests/runtime/data/";
+  const std::vector<std::string> pencil = {"modes", "--M", data + "Mjordan.mtx", "--Q", data + "Qjordan.mtx",
+                                           "--K", data + "Kjordan_noisy.mtx", "--all"};
+  auto with = [&pencil](std::vector<std::string> more) {
+    std::vector<std::string> a = pencil;
+    a.insert(a.end(), more.begin(), more.end());
+    return run_linear(a);
+  };
+  LinearRun r = with({});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  int zero_within = 0, finite = 0;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] == '#' || line.find("lambda_re") != std::string::npos) continue;
+    std::istringstream fields(line);
+    std::string k, re, im, fn, fd, zeta, eta, bound, kind;
+    fields >> k >> re >> im >> fn >> fd >> zeta >> eta >> bound >> kind;
+    if (kind == "zero_within_bound") {
+      ++zero_within;
+      EXPECT_EQ(zeta, "-") << line;
+      // The noise-free truth, λ = 0, lies within the bound: |λ| ≤ error_bound.
+      EXPECT_LE(std::abs(std::stod(re)) + std::abs(std::stod(im)), std::stod(bound)) << line;
+    } else {
+      ++finite;
+      EXPECT_EQ(kind, "finite") << line;
+      // Relative motion μλ² + cλ + k = 0 (μ = 2/3, c = 0.5, k = 100): Re λ = −c/(2μ) = −0.375;
+      // ζ = c/(2√(kμ)) = 0.0306186 (6 digits printed).
+      EXPECT_EQ(re, "-3.750000e-01") << line;
+      EXPECT_EQ(zeta, "3.061862e-02") << line;
+    }
+  }
+  EXPECT_EQ(zero_within, 2);
+  EXPECT_EQ(finite, 2);
+  EXPECT_NE(r.out.find("\n# stability undecided: none unstable; an eigenvalue is zero within its error "
+                       "bound or has |Re lambda| <= error_bound\n"),
+            std::string::npos)
+      << r.out;
+  r = with({"--format", "json"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("\"damping_ratio\":null,"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("\"damping_ratio\":-1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("],\"stability\":\"undecided\"}\n"), std::string::npos) << r.out;
+  r = with({"--format", "csv"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("lambda_re,lambda_im,natural_frequency_hz,damped_frequency_hz,damping_ratio,"
+                        "backward_error,error_bound,kind\n",
+                        0),
+            0u);
+  EXPECT_NE(r.out.find(",,"), std::string::npos) << "empty damping ratio field";
 }
