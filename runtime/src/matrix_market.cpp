@@ -148,7 +148,8 @@ void read_size(Lines& lines, Header& h) {
   h.cols = count(t[1]);
   const long long declared = h.coordinate ? count(t[2]) : 0;
   if (h.rows < 0 || h.cols < 0 || declared < 0)
-    lines.fail("malformed size line '" + line + "' (expected " + form + ", non-negative integers)");
+    lines.fail("malformed size line '" + line + "' (expected " + form +
+               ", non-negative integers of at most 18 digits)");
   const long long n = h.rows;
   if (h.symmetry != Symmetry::general && h.rows != h.cols)
     lines.fail(symmetry_name(h.symmetry) + " storage of a non-square " + std::to_string(h.rows) + "x" +
