@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <sstream>
 
@@ -36,6 +37,39 @@ std::string name_list(const std::vector<std::string>& names) {
   return s;
 }
 
+// The diagonal blocks of a symmetric matrix, up to a permutation: the connected components of
+// its graph of nonzero entries, each in ascending order, ordered by their first index. The
+// eigenvalues of M are those of its blocks, so that a model of decoupled parts is checked block
+// by block (2,000 decoupled oscillators: 2,000 blocks of one, not one dense eigenproblem of
+// order 2,000).
+std::vector<std::vector<Eigen::Index>> coupled_blocks(const Eigen::MatrixXd& M) {
+  const Eigen::Index n = M.rows();
+  std::vector<Eigen::Index> parent(static_cast<std::size_t>(n));
+  std::iota(parent.begin(), parent.end(), Eigen::Index{0});
+  auto root = [&](Eigen::Index i) {
+    while (parent[static_cast<std::size_t>(i)] != i)
+      i = parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    return i;
+  };
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (i != j && (M(i, j) != 0 || M(j, i) != 0)) {
+        const Eigen::Index a = root(i), b = root(j);
+        if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+      }
+  std::vector<std::vector<Eigen::Index>> blocks;
+  std::vector<std::size_t> block_of(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Index r = root(i);
+    if (r == i) {
+      block_of[static_cast<std::size_t>(i)] = blocks.size();
+      blocks.emplace_back();
+    }
+    blocks[block_of[static_cast<std::size_t>(r)]].push_back(i);
+  }
+  return blocks;
+}
+
 }  // namespace
 
 void check_operating_point(const Equations& eq, const LinearEquations& lin) {
@@ -54,21 +88,30 @@ void check_operating_point(const Equations& eq, const LinearEquations& lin) {
   }
   for (const auto& u : eq.u) values[u] = 0;
 
+  // M, K, Q and the residual, in this order; exact zeros are not evaluated (most entries of a
+  // large model's matrices).
   std::vector<GiNaC::ex> entries;
+  std::vector<std::size_t> slot;  // entry k of the list above → index in `entries`
+  auto add = [&](const GiNaC::ex& e) {
+    slot.push_back(e.is_zero() ? SIZE_MAX : entries.size());
+    if (!e.is_zero()) entries.push_back(e);
+  };
   for (const ExMatrix* A : {&eq.M, &lin.K, &lin.Q})
     for (std::size_t i = 0; i < f; ++i)
-      for (std::size_t j = 0; j < f; ++j) entries.push_back((*A)[i][j]);
-  for (const auto& r : eq.residual) entries.push_back(r);
+      for (std::size_t j = 0; j < f; ++j) add((*A)[i][j]);
+  for (const auto& r : eq.residual) add(r);
 
-  std::vector<double> v(entries.size());
+  std::vector<double> v(slot.size(), 0.0);
   const long digits = GiNaC::Digits;
   GiNaC::Digits = detail::PointEvaluator::kDigits;
   try {
     const std::vector<GiNaC::numeric> n = detail::PointEvaluator(eq.program, values).evaluate(entries);
-    for (std::size_t i = 0; i < n.size(); ++i) {
-      if (!n[i].is_real()) throw std::runtime_error("a complex value");
-      v[i] = n[i].to_double();
-      if (!std::isfinite(v[i])) throw std::runtime_error("a value beyond the range of double");
+    for (std::size_t k = 0; k < slot.size(); ++k) {
+      if (slot[k] == SIZE_MAX) continue;
+      const GiNaC::numeric& x = n[slot[k]];
+      if (!x.is_real()) throw std::runtime_error("a complex value");
+      v[k] = x.to_double();
+      if (!std::isfinite(v[k])) throw std::runtime_error("a value beyond the range of double");
     }
   } catch (const std::exception& e) {
     GiNaC::Digits = digits;
@@ -107,15 +150,22 @@ void check_operating_point(const Equations& eq, const LinearEquations& lin) {
                                 std::string(massless.size() > 1 ? "s " : " ") + name_list(massless) +
                                 (massless.size() > 1 ? " move" : " moves") +
                                 " no mass (give the bodies it moves a mass or inertia)");
-  const VectorXd d = M.diagonal().cwiseSqrt().cwiseInverse();
-  const MatrixXd S = d.asDiagonal() * M * d.asDiagonal();
-  Eigen::SelfAdjointEigenSolver<MatrixXd> es(S);
-  if (es.info() == Eigen::Success && es.eigenvalues()(0) < 1e-10) {
+  for (const std::vector<Eigen::Index>& block : coupled_blocks(M)) {
+    if (block.size() == 1) continue;  // a positive diagonal entry (checked above)
+    const auto n = static_cast<Eigen::Index>(block.size());
+    MatrixXd S(n, n);  // the equilibrated block D^-1/2 M D^-1/2
+    for (Eigen::Index a = 0; a < n; ++a)
+      for (Eigen::Index b = 0; b < n; ++b) {
+        const Eigen::Index i = block[static_cast<std::size_t>(a)], j = block[static_cast<std::size_t>(b)];
+        S(a, b) = M(i, j) / std::sqrt(M(i, i) * M(j, j));
+      }
+    Eigen::SelfAdjointEigenSolver<MatrixXd> es(S);
+    if (es.info() != Eigen::Success || !(es.eigenvalues()(0) < 1e-10)) continue;
     const VectorXd null = es.eigenvectors().col(0);
     const double big = null.cwiseAbs().maxCoeff();
     std::vector<std::string> involved;
-    for (Eigen::Index i = 0; i < null.size(); ++i)
-      if (std::abs(null(i)) > 0.1 * big) involved.push_back(coordinate(i));
+    for (Eigen::Index a = 0; a < n; ++a)
+      if (std::abs(null(a)) > 0.1 * big) involved.push_back(coordinate(block[static_cast<std::size_t>(a)]));
     throw ModelError(where, "the mass matrix is singular at the operating point (a kinematic "
                             "singularity such as gimbal lock): the rates of coordinates " +
                                 name_list(involved) +

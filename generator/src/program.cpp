@@ -5,6 +5,11 @@
 
 namespace mbsgen {
 
+namespace {
+// Sums of more terms than this are differentiated term by term (Program::sum_index).
+constexpr std::size_t kSumIndexMinTerms = 16;
+}  // namespace
+
 using GiNaC::ex;
 using GiNaC::ex_to;
 using GiNaC::is_a;
@@ -128,13 +133,36 @@ ex Program::diff_intermediate(std::size_t k, std::size_t variable) {
   const std::uint64_t key = static_cast<std::uint64_t>(k) * variables_.size() + variable;
   if (auto it = diff_memo_.find(key); it != diff_memo_.end()) return it->second;
   ex value = defs_[k].value;  // copy: define() may reallocate defs_
+  // A long sum: only its terms that depend on the variable (the others differentiate to 0, so
+  // the result is the same expression, in time proportional to those terms).
+  if (is_a<GiNaC::add>(value) && value.nops() > kSumIndexMinTerms) {
+    GiNaC::exvector terms;
+    const auto& index = sum_index(k).terms_of;
+    if (auto it = index.find(variable); it != index.end())
+      for (std::size_t i : it->second) terms.push_back(value.op(i));
+    value = GiNaC::add(terms);
+  }
   ex d = define(diff(value, variables_[variable]));
   diff_memo_.emplace(key, d);
   return d;
 }
 
+const Program::SumIndex& Program::sum_index(std::size_t k) {
+  if (auto it = sum_index_.find(k); it != sum_index_.end()) return it->second;
+  SumIndex index;
+  const ex& value = defs_[k].value;
+  for (std::size_t i = 0; i < value.nops(); ++i) {
+    const Bits bits = dependencies(value.op(i));
+    for (std::size_t w = 0; w < bits.size(); ++w)
+      for (std::uint64_t b = bits[w]; b != 0; b &= b - 1)
+        index.terms_of[w * 64 + static_cast<std::size_t>(__builtin_ctzll(b))].push_back(i);
+  }
+  return sum_index_.emplace(k, std::move(index)).first->second;
+}
+
 ex Program::diff(const ex& e, const GiNaC::symbol& x) {
   const std::size_t var = variable(x, "diff");
+  if (is_a<GiNaC::numeric>(e)) return 0;
   if (is_a<GiNaC::symbol>(e)) {
     if (e.is_equal(x)) return 1;
     if (auto d = def_index_.find(e); d != def_index_.end()) return diff_intermediate(d->second, var);
@@ -161,6 +189,7 @@ ex Program::substitute_intermediate(std::size_t k, Substitution& s) {
 }
 
 ex Program::substitute(const ex& e, Substitution& s) {
+  if (is_a<GiNaC::numeric>(e)) return e;
   if (s.mask_.empty()) {
     s.mask_.assign((variables_.size() + 63) / 64, 0);
     for (const auto& [key, value] : s.values_) {
@@ -172,7 +201,23 @@ ex Program::substitute(const ex& e, Substitution& s) {
   }
   std::vector<std::size_t> ts;
   collect_intermediates(e, ts);
-  GiNaC::exmap m = s.values_;
+  // Only the variables e holds itself: copying every value per call made a model's f^2 entries
+  // cost f^3 (issue 14 §4: 2,000 decoupled oscillators).
+  GiNaC::exmap m;
+  if (s.values_.size() <= 8) {
+    m = s.values_;
+  } else {
+    std::vector<ex> stack{e};
+    while (!stack.empty()) {
+      const ex x = stack.back();
+      stack.pop_back();
+      if (is_a<GiNaC::symbol>(x)) {
+        if (auto v = s.values_.find(x); v != s.values_.end()) m.insert(*v);
+        continue;
+      }
+      for (std::size_t i = 0; i < x.nops(); ++i) stack.push_back(x.op(i));
+    }
+  }
   for (std::size_t k : ts) {
     ex r = substitute_intermediate(k, s);
     if (!r.is_equal(defs_[k].symbol)) m[defs_[k].symbol] = r;

@@ -39,9 +39,13 @@ std::vector<Target> targets(LinearEquations& lin, StructuralZeros& z) {
 std::vector<ZeroPattern> screen(Equations& eq, LinearEquations& lin, StructuralZeros& z,
                                 bool at_operating_point) {
   std::vector<Target> ts = targets(lin, z);
+  // Only the entries that are not already exact zeros (most of a large model's: evaluating all
+  // f^2 of them made the screen quadratic in its cost per entry).
   std::vector<ex> entries;
   for (const Target& t : ts)
-    for (const auto& row : *t.matrix) entries.insert(entries.end(), row.begin(), row.end());
+    for (const auto& row : *t.matrix)
+      for (const ex& x : row)
+        if (!x.is_zero()) entries.push_back(x);
   std::vector<ZeroPattern> cand;
   for (const Target& t : ts) {
     ZeroPattern p(t.matrix->size());
@@ -74,12 +78,14 @@ std::vector<ZeroPattern> screen(Equations& eq, LinearEquations& lin, StructuralZ
         const std::size_t begin = at;
         GiNaC::numeric scale = 0;
         for (const auto& row : A)
-          for (std::size_t j = 0; j < row.size(); ++j) scale = std::max(scale, GiNaC::abs(v[at++]));
+          for (const ex& x : row)
+            if (!x.is_zero()) scale = std::max(scale, GiNaC::abs(v[at++]));
         const GiNaC::numeric tol = scale * GiNaC::numeric(10).power(-30);
         at = begin;
         for (std::size_t i = 0; i < A.size(); ++i)
-          for (std::size_t j = 0; j < A[i].size(); ++j, ++at) {
-            const bool small = GiNaC::abs(v[at]) <= tol && !A[i][j].is_zero();
+          for (std::size_t j = 0; j < A[i].size(); ++j) {
+            if (A[i][j].is_zero()) continue;  // nonzero in cand: not a candidate, as before
+            const bool small = GiNaC::abs(v[at++]) <= tol;
             EntryZero& c = cand[m][i][j];
             if (point == 0) c = small ? EntryZero::everywhere : EntryZero::nonzero;
             else if (!small) c = EntryZero::nonzero;

@@ -84,6 +84,13 @@ class Program {
   CanonicalOrder order_;  // intermediates are numbered in this order, not in GiNaC's
   std::unordered_map<std::uint64_t, GiNaC::ex> diff_memo_;
   std::unordered_map<std::size_t, GiNaC::ex> inline_memo_;
+  // For an intermediate defined as a long sum (a model's potential): per variable, the terms
+  // that depend on it, so that each derivative differentiates only those.
+  struct SumIndex {
+    std::unordered_map<std::size_t, std::vector<std::size_t>> terms_of;  ///< variable → operands
+  };
+  std::unordered_map<std::size_t, SumIndex> sum_index_;
+  const SumIndex& sum_index(std::size_t k);
 };
 
 }  // namespace mbsgen
