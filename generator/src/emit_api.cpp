@@ -54,7 +54,8 @@ bool has_kernel(const GeneratedCode& code, const std::string& name) {
 }  // namespace
 
 GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const GeneratedCode& code,
-                      const std::string& scene, double from_hz, double to_hz) {
+                      const std::string& scene, double from_hz, double to_hz, int points,
+                      bool linear_spacing) {
   GeneratedApi api;
   api.id = code.id;
   const std::string& id = code.id;
@@ -144,7 +145,8 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     << ",\n      " << id << "_coordinate_names, coordinate_units, " << id << "_parameter_names, parameter_units, "
     << id << "_parameter_defaults,\n      " << id << "_input_names, input_units, " << id
     << "_output_names, output_units,\n      " << kernel("operating_point") << ", " << kernel("linear")
-    << ", " << kernel("residual") << ", " << kernel("mass_matrix") << "};\n  return k;\n}\n\n";
+    << ", " << kernel("residual") << ", " << kernel("mass_matrix") << ",\n      " << points << ", "
+    << (linear_spacing ? "true" : "false") << ", " << literal(kGeneratorVersion) << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"
        "  return m;\n}\n\n";

@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "progress.hpp"
 #include "run.hpp"
 
 #include <chrono>
@@ -140,12 +141,18 @@ int main(int argc, char** argv) try {
   }
   try {
     auto t0 = std::chrono::steady_clock::now();
+    mbsgen::tool::Progress progress(*check ? "check" : *info ? "info" : "generate");
     mbsgen::Model model = mbsgen::read_model_file(model_file);
     const mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
+    progress.stage("deriving the equations");
     mbsgen::Equations eq = mbsgen::derive(pruned);
+    progress.stage("linearizing");
     mbsgen::LinearEquations lin = mbsgen::linearize(eq);
+    progress.stage("checking the operating point");
     mbsgen::check_operating_point(eq, lin);
+    progress.stage("emitting the kernels");
     if (*check) {
+      progress.stop();
       std::cout << model_file << ": ok (" << model.bodies().size() << " bodies, "
                 << model.coordinates().size() << " coordinates)\n";
       return 0;
@@ -155,12 +162,14 @@ int main(int argc, char** argv) try {
     options.source_file = model_file;
     options.id = id;
     mbsgen::GeneratedCode code = mbsgen::emit(pruned, eq, lin, options);
+    progress.stop();
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (*info) return print_info(pruned, model.scenes(), lin, code, seconds);
     const auto& range = pruned.selection().frequency_range;
     mbsgen::write_generated(code,
                             mbsgen::emit_api(pruned, lin, code, scene, range ? range->from_hz : 0.0,
-                                             range ? range->to_hz : 0.0),
+                                             range ? range->to_hz : 0.0, range ? range->points : 0,
+                                             range ? !range->logarithmic : false),
                             out_dir);
     std::cerr << "mbsgen: wrote " << out_dir << "/" << code.id << "{.hpp,.cpp,.json,_model.hpp,_model.cpp} in " << seconds
               << " s\n";

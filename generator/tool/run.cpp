@@ -180,7 +180,8 @@ bool build_solver(const std::string& model_file, const std::string& scene, const
   options.id = "model";
   GeneratedCode code = emit(model, eq, lin, options);
   const auto& range = model.selection().frequency_range;
-  GeneratedApi api = emit_api(model, lin, code, scene, range ? range->from_hz : 0.0, range ? range->to_hz : 0.0);
+  GeneratedApi api = emit_api(model, lin, code, scene, range ? range->from_hz : 0.0, range ? range->to_hz : 0.0,
+                              range ? range->points : 0, range ? !range->logarithmic : false);
   std::string name = dir.string() + ".tmp-XXXXXX";
   if (!::mkdtemp(name.data()))
     throw std::runtime_error("cannot create a directory beside " + dir.string() + ": " + std::strerror(errno));

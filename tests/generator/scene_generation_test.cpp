@@ -4,6 +4,7 @@
 // manifest say what the scene kept.
 #include "mbsgen/generator/chain.hpp"
 #include "mbsgen/generator/emit.hpp"
+#include "mbsgen/generator/emit_api.hpp"
 #include "mbsgen/generator/scene.hpp"
 #include "mbsgen/generator/yaml_reader.hpp"
 
@@ -145,6 +146,19 @@ TEST(Scenes, HeaderDeclaresOnlyTheEmittedKernels) {
   EXPECT_NE(spinning.code.header.find("#define rotor_disk_spinning_FREQUENCY_FROM_HZ 1.0\n"), std::string::npos);
   EXPECT_NE(spinning.code.header.find("#define rotor_disk_spinning_FREQUENCY_TO_HZ 100.0\n"), std::string::npos);
   EXPECT_NE(spinning.code.header.find("#define rotor_disk_spinning_FREQUENCY_POINTS 400\n"), std::string::npos);
+}
+
+// The typed API carries the scene's sweep (from, to, points, spacing) and the generator's
+// version to the solver (ModelKernels' trailing fields; issue 14 §6).
+TEST(Scenes, ApiCarriesTheSceneSweepAndTheGeneratorVersion) {
+  const Model rotor = read_model_file(kSourceDir + "/models/textbook/rotor_disk.yaml");
+  const Generated spinning = generate(rotor, "spinning");
+  const auto& r = spinning.model.selection().frequency_range;
+  ASSERT_TRUE(r.has_value());
+  const GeneratedApi api = emit_api(spinning.model, spinning.lin, spinning.code, "spinning", r->from_hz,
+                                    r->to_hz, r->points, !r->logarithmic);
+  EXPECT_NE(api.source.find("400, false, \"" + std::string(kGeneratorVersion) + "\"};"), std::string::npos)
+      << api.source;
 }
 
 TEST(Scenes, ManifestListsEffectsStructureAndKernels) {

@@ -19,7 +19,8 @@ struct GeneratedApi {
 /// model: the model as generated (for a scene, the scene's model); code: what emit() returned
 /// for it; from_hz, to_hz: the scene's default frequency range (0, 0 for none).
 GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const GeneratedCode& code,
-                      const std::string& scene, double from_hz = 0, double to_hz = 0);
+                      const std::string& scene, double from_hz = 0, double to_hz = 0,
+                      int points = 0, bool linear_spacing = false);
 
 /// `<id>_model.hpp` and `<id>_model.cpp` in dir, for write_files (output_files.hpp).
 std::vector<OutputFile> api_files(const GeneratedApi& api, const std::string& dir);
