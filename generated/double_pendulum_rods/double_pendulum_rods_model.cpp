@@ -23,7 +23,8 @@ const mbsgen::ModelKernels& kernels() {
       2, 0, 1, 3, true, false, 0.0, 0.0,
       double_pendulum_rods_coordinate_names, coordinate_units, double_pendulum_rods_parameter_names, parameter_units, double_pendulum_rods_parameter_defaults,
       double_pendulum_rods_input_names, input_units, double_pendulum_rods_output_names, output_units,
-      &double_pendulum_rods_operating_point, &double_pendulum_rods_linear, &double_pendulum_rods_residual, &double_pendulum_rods_mass_matrix};
+      &double_pendulum_rods_operating_point, &double_pendulum_rods_linear, &double_pendulum_rods_residual, &double_pendulum_rods_mass_matrix,
+      0, false, "0.1.0"};
   return k;
 }
 

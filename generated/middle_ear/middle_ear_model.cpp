@@ -23,7 +23,8 @@ const mbsgen::ModelKernels& kernels() {
       18, 1, 9, 87, true, false, 0.0, 0.0,
       middle_ear_coordinate_names, coordinate_units, middle_ear_parameter_names, parameter_units, middle_ear_parameter_defaults,
       middle_ear_input_names, input_units, middle_ear_output_names, output_units,
-      &middle_ear_operating_point, &middle_ear_linear, &middle_ear_residual, &middle_ear_mass_matrix};
+      &middle_ear_operating_point, &middle_ear_linear, &middle_ear_residual, &middle_ear_mass_matrix,
+      0, false, "0.1.0"};
   return k;
 }
 

@@ -23,7 +23,8 @@ const mbsgen::ModelKernels& kernels() {
       1, 0, 1, 3, true, false, 0.0, 0.0,
       physical_pendulum_coordinate_names, coordinate_units, physical_pendulum_parameter_names, parameter_units, physical_pendulum_parameter_defaults,
       physical_pendulum_input_names, input_units, physical_pendulum_output_names, output_units,
-      &physical_pendulum_operating_point, &physical_pendulum_linear, &physical_pendulum_residual, &physical_pendulum_mass_matrix};
+      &physical_pendulum_operating_point, &physical_pendulum_linear, &physical_pendulum_residual, &physical_pendulum_mass_matrix,
+      0, false, "0.1.0"};
   return k;
 }
 

@@ -23,7 +23,8 @@ const mbsgen::ModelKernels& kernels() {
       1, 0, 2, 3, true, false, 0.0, 0.0,
       simple_pendulum_coordinate_names, coordinate_units, simple_pendulum_parameter_names, parameter_units, simple_pendulum_parameter_defaults,
       simple_pendulum_input_names, input_units, simple_pendulum_output_names, output_units,
-      &simple_pendulum_operating_point, &simple_pendulum_linear, &simple_pendulum_residual, &simple_pendulum_mass_matrix};
+      &simple_pendulum_operating_point, &simple_pendulum_linear, &simple_pendulum_residual, &simple_pendulum_mass_matrix,
+      0, false, "0.1.0"};
   return k;
 }
 

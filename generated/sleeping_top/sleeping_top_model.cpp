@@ -23,7 +23,8 @@ const mbsgen::ModelKernels& kernels() {
       3, 0, 1, 6, false, false, 0.0, 0.0,
       sleeping_top_coordinate_names, coordinate_units, sleeping_top_parameter_names, parameter_units, sleeping_top_parameter_defaults,
       sleeping_top_input_names, input_units, sleeping_top_output_names, output_units,
-      &sleeping_top_operating_point, &sleeping_top_linear, &sleeping_top_residual, &sleeping_top_mass_matrix};
+      &sleeping_top_operating_point, &sleeping_top_linear, &sleeping_top_residual, &sleeping_top_mass_matrix,
+      0, false, "0.1.0"};
   return k;
 }
 

@@ -23,7 +23,8 @@ const mbsgen::ModelKernels& kernels() {
       2, 0, 2, 3, false, false, 0.0, 0.0,
       spherical_pendulum_conical_coordinate_names, coordinate_units, spherical_pendulum_conical_parameter_names, parameter_units, spherical_pendulum_conical_parameter_defaults,
       spherical_pendulum_conical_input_names, input_units, spherical_pendulum_conical_output_names, output_units,
-      &spherical_pendulum_conical_operating_point, &spherical_pendulum_conical_linear, &spherical_pendulum_conical_residual, &spherical_pendulum_conical_mass_matrix};
+      &spherical_pendulum_conical_operating_point, &spherical_pendulum_conical_linear, &spherical_pendulum_conical_residual, &spherical_pendulum_conical_mass_matrix,
+      0, false, "0.1.0"};
   return k;
 }
 

@@ -23,7 +23,8 @@ const mbsgen::ModelKernels& kernels() {
       5, 0, 1, 3, true, true, 0.0, 0.0,
       spring_chain_fixed_fixed_coordinate_names, coordinate_units, spring_chain_fixed_fixed_parameter_names, parameter_units, spring_chain_fixed_fixed_parameter_defaults,
       spring_chain_fixed_fixed_input_names, input_units, spring_chain_fixed_fixed_output_names, output_units,
-      &spring_chain_fixed_fixed_operating_point, &spring_chain_fixed_fixed_linear, &spring_chain_fixed_fixed_residual, &spring_chain_fixed_fixed_mass_matrix};
+      &spring_chain_fixed_fixed_operating_point, &spring_chain_fixed_fixed_linear, &spring_chain_fixed_fixed_residual, &spring_chain_fixed_fixed_mass_matrix,
+      0, false, "0.1.0"};
   return k;
 }
 
