@@ -3,11 +3,14 @@
 #include "mbsgen/generator/scene.hpp"
 
 #include "checked_subs.hpp"
+#include "operating_point_checks.hpp"
 
 #include <Eigen/Eigenvalues>
 
 #include <cctype>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <functional>
 #include <set>
 #include <sstream>
@@ -247,8 +250,10 @@ double numeric_value(const GiNaC::ex& e, const GiNaC::exmap& defaults, bool& ok)
   return ok ? GiNaC::ex_to<GiNaC::numeric>(v).to_double() : 0.0;
 }
 
-// The principal moments of a symmetric 3×3 tensor in ascending order (Eigen's closed-form
-// solver for 3×3 self-adjoint matrices).
+// The principal moments of a symmetric 3×3 tensor in ascending order. Eigen's iterative solver,
+// backward stable (each moment within a few ulps of the largest): its closed-form 3×3 solver
+// loses half the digits at a double moment, so that a slender rod (0, B, B) came out with
+// A + B < C by 1e-9 of C for some values of m and L.
 Eigen::Vector3d principal_moments(const Mat3& I, const GiNaC::exmap& defaults, bool& ok) {
   Eigen::Matrix3d A;
   ok = true;
@@ -259,9 +264,49 @@ Eigen::Vector3d principal_moments(const Mat3& I, const GiNaC::exmap& defaults, b
       ok = ok && entry_ok && std::isfinite(A(i, j));
     }
   if (!ok) return Eigen::Vector3d::Zero();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-  es.computeDirect(A, Eigen::EigenvaluesOnly);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(A, Eigen::EigenvaluesOnly);
   return es.eigenvalues();
+}
+
+// A double as the exact rational it is.
+GiNaC::numeric exact_rational(double v) {
+  int e = 0;
+  const double m = std::frexp(v, &e);  // v = m 2^e, 0.5 <= |m| < 1
+  const long mantissa = static_cast<long>(std::ldexp(m, 53));
+  return GiNaC::numeric(mantissa) * GiNaC::numeric(2).power(e - 53);
+}
+
+// The 3×3 tensor exactly, when its entries are rational at the (exact) default parameter values.
+std::optional<std::array<std::array<GiNaC::numeric, 3>, 3>> exact_tensor(const Mat3& I,
+                                                                         const GiNaC::exmap& exact) {
+  std::array<std::array<GiNaC::numeric, 3>, 3> J;
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t j = 0; j < 3; ++j) {
+      GiNaC::ex v;
+      try {
+        v = detail::checked_subs(I[i][j], exact);
+      } catch (const std::exception&) {
+        return std::nullopt;
+      }
+      if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_rational())
+        return std::nullopt;
+      J[i][j] = GiNaC::ex_to<GiNaC::numeric>(v);
+    }
+  return J;
+}
+
+// Whether a symmetric 3×3 rational matrix is positive semi-definite: all its principal minors
+// (three 1×1, three 2×2 and the determinant) are >= 0, decided exactly.
+bool exactly_semidefinite(const std::array<std::array<GiNaC::numeric, 3>, 3>& A) {
+  for (std::size_t i = 0; i < 3; ++i)
+    if (A[i][i].is_negative()) return false;
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t j = i + 1; j < 3; ++j)
+      if ((A[i][i] * A[j][j] - A[i][j] * A[j][i]).is_negative()) return false;
+  const GiNaC::numeric det = A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) -
+                             A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
+                             A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]);
+  return !det.is_negative();
 }
 
 bool inertia_is_zero(const Mat3& I, const GiNaC::exmap& defaults) {
@@ -269,22 +314,39 @@ bool inertia_is_zero(const Mat3& I, const GiNaC::exmap& defaults) {
   return principal_moments(I, defaults, ok).cwiseAbs().maxCoeff() == 0 && ok;
 }
 
-std::string inertia_problem(const Mat3& I, const GiNaC::exmap& defaults) {
+// A tensor J about the centre of mass has principal moments A = ∫(y²+z²) dm, … so that
+// A, B, C >= 0 and A + B >= C (equality for a flat body): J = tr(Σ) E − Σ with the second moment
+// Σ = ∫ r rᵀ dm, and the conditions hold exactly when Σ = (tr J / 2) E − J is positive
+// semi-definite (its eigenvalues are (A + B − C)/2, …). Point masses (all zero) and slender rods
+// (one zero) are allowed idealizations. Where the entries are rational at the default parameter
+// values (decimal literals and parameter values are exact rationals) this is decided exactly, by
+// principal minors; otherwise from the eigenvalues d of J computed in double by a backward-stable
+// solver, within 32 ε max|d| (the entries' rounding, a few ulps, plus the solver's, a few ulps
+// times the dimension 3).
+std::string inertia_problem(const Mat3& I, const GiNaC::exmap& defaults, const GiNaC::exmap& exact) {
   bool ok = false;
   const Eigen::Vector3d d = principal_moments(I, defaults, ok);
   if (!ok) return "an inertia tensor that is not numeric (or not finite) with the default parameter values";
-  // A tensor about the centre of mass has principal moments A = ∫(y²+z²) dm, … so that
-  // A, B, C ≥ 0 and A + B ≥ C (equality for a flat body). Point masses (all zero) and slender
-  // rods (one zero) are allowed idealizations. The tolerance covers the rounding of the
-  // closed-form eigenvalues and of decimal inputs: 1e-9 of the largest moment.
-  const double tol = 1e-9 * d.cwiseAbs().maxCoeff();
+  bool semidefinite = false, triangle = false;
+  if (const auto J = exact_tensor(I, exact)) {
+    semidefinite = exactly_semidefinite(*J);
+    auto S = *J;
+    const GiNaC::numeric half_trace = ((*J)[0][0] + (*J)[1][1] + (*J)[2][2]) / 2;
+    for (std::size_t i = 0; i < 3; ++i)
+      for (std::size_t j = 0; j < 3; ++j) S[i][j] = (i == j ? half_trace : GiNaC::numeric(0)) - (*J)[i][j];
+    triangle = exactly_semidefinite(S);
+  } else {
+    const double tol = 32 * std::numeric_limits<double>::epsilon() * d.cwiseAbs().maxCoeff();
+    semidefinite = d(0) >= -tol;
+    triangle = d(0) + d(1) - d(2) >= -2 * tol;
+  }
   std::ostringstream moments;
   moments.precision(6);
   moments << d(0) << ", " << d(1) << ", " << d(2);
-  if (d(0) < -tol)
+  if (!semidefinite)
     return "an inertia tensor that is not positive semi-definite (principal moments " + moments.str() +
            " kg m^2)";
-  if (d(0) + d(1) < d(2) - tol)
+  if (!triangle)
     return "an inertia tensor that violates the triangle inequality: its principal moments " +
            moments.str() + " kg m^2 have A + B < C, which no mass distribution gives";
   return {};
@@ -318,8 +380,9 @@ void Model::validate() const {
     }
   };
 
-  GiNaC::exmap defaults;
+  GiNaC::exmap defaults, exact_defaults;
   for (const auto& p : parameters_) defaults[p.symbol] = GiNaC::numeric(p.value);
+  for (const auto& p : parameters_) exact_defaults[p.symbol] = exact_rational(p.value);
 
   // The tree: every parent exists and is defined before its children (so no cycles).
   std::set<std::string> seen;
@@ -347,7 +410,7 @@ void Model::validate() const {
       for (int j = 0; j < 3; ++j)
         if (!(b.inertia[i][j] - b.inertia[j][i]).is_zero())
           throw ModelError(b.where, "body '" + b.name + "': the inertia tensor is not symmetric");
-    const std::string inertia_error = inertia_problem(b.inertia, defaults);
+    const std::string inertia_error = inertia_problem(b.inertia, defaults, exact_defaults);
     if (!inertia_error.empty()) throw ModelError(b.where, "body '" + b.name + "' has " + inertia_error);
     if (m == 0 && !inertia_is_zero(b.inertia, defaults))
       throw ModelError(b.where, "body '" + b.name +
@@ -364,6 +427,10 @@ void Model::validate() const {
     check_marker(s.marker_b, s.where, "spring '" + s.name + "'");
     check_expr(s.stiffness, s.where, "a spring stiffness", parameters_only);
     check_expr(s.rest_length, s.where, "a rest length", parameters_only);
+    bool ok = false;
+    if (const double L0 = numeric_value(s.rest_length, defaults, ok); ok && L0 < 0)
+      throw ModelError(s.where, "spring '" + s.name + "' has a negative rest length (" +
+                                    detail::checked_subs_impl::describe(GiNaC::numeric(L0)) + " m)");
   }
   for (const auto& d : dampers_) {
     check_marker(d.marker_a, d.where, "damper '" + d.name + "'");
@@ -422,6 +489,8 @@ void Model::validate() const {
   }
   if (coordinates_.empty()) throw ModelError({}, "model '" + name_ + "' has no coordinates");
   for (const auto& s : scenes_) check_scene(*this, s);
+  detail::check_derivatives_at_operating_point(*this, exact_defaults);
+  detail::check_force_directions(*this, exact_defaults);
 }
 
 }  // namespace mbsgen

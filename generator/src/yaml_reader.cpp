@@ -1,6 +1,9 @@
 #include "mbsgen/generator/yaml_reader.hpp"
 
+#include "mbsgen/generator/escape.hpp"
+
 #include "checked_subs.hpp"
+#include "expression_sites.hpp"
 
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/eventhandler.h>
@@ -292,6 +295,11 @@ class ExpressionChecker {
 
   void call(const Token& name) {
     const auto& fns = known_functions();
+    static const std::vector<std::string> steps = {"heaviside", "sgn", "sign", "signum", "step"};
+    if (std::binary_search(steps.begin(), steps.end(), name.text))
+      throw ExpressionError(name.pos, "unknown function '" + name.text + "': a step or sign has "
+                                      "no derivative at 0, and the linear model needs one; write a "
+                                      "law that is smooth at the operating point");
     if (!std::binary_search(fns.begin(), fns.end(), name.text))
       throw ExpressionError(name.pos, "unknown function '" + name.text + "'" +
                                           suggestion(name.text, fns));
@@ -371,8 +379,46 @@ class Rebuild {
   const Leaves& leaves_;
 };
 
+// What parse_checked also does, beyond parsing (expression_sites.hpp): refuse inputs that do not
+// enter linearly, and return the calls and powers that depend on symbols, with their places.
+struct ParseExtras {
+  bool linear_inputs = false;
+  std::vector<detail::ExpressionSite> sites;
+};
+
+// The function calls of a checked token stream, with the placeholders of their arguments
+// (placeholders are numbered in the order of their tokens).
+std::vector<detail::Call> calls_of(const std::vector<Token>& tokens) {
+  std::vector<detail::Call> calls;
+  std::vector<long> open;  // index into calls, or -1 for a parenthesis
+  std::size_t leaves = 0;
+  for (std::size_t k = 0; k + 1 < tokens.size(); ++k) {
+    const Token& tok = tokens[k];
+    const bool call = tok.kind == Token::Kind::identifier && tokens[k + 1].text == "(" &&
+                      tokens[k + 1].kind == Token::Kind::op;
+    if (call) {
+      open.push_back(static_cast<long>(calls.size()));
+      calls.push_back({tok.text, tok.pos, 0, leaves, 0, open.size() - 1, false});
+      ++k;  // its '('
+    } else if (tok.kind == Token::Kind::op && tok.text == "(") {
+      open.push_back(-1);
+    } else if (tok.kind == Token::Kind::op && tok.text == ")") {
+      if (!open.empty() && open.back() >= 0) {
+        detail::Call& c = calls[static_cast<std::size_t>(open.back())];
+        c.end = tok.pos + 1;
+        c.last_leaf = leaves == 0 ? 0 : leaves - 1;
+      }
+      if (!open.empty()) open.pop_back();
+    } else if (tok.kind != Token::Kind::op) {
+      ++leaves;
+    }
+  }
+  return calls;
+}
+
 GiNaC::ex parse_checked(const Model& model, const std::string& text,
-                        const ExpressionChecker::SymbolCheck& check_known) {
+                        const ExpressionChecker::SymbolCheck& check_known,
+                        ParseExtras* extras = nullptr) {
   const std::vector<Token> tokens = lex(text);
   auto check = [&](const Token& tok) {
     if (tok.text == "Pi" || tok.text == "Euler" || tok.text == "Catalan") return;
@@ -394,6 +440,7 @@ GiNaC::ex parse_checked(const Model& model, const std::string& text,
   // 10^10^6 not yet a number); Rebuild then puts in the values, checking each power.
   GiNaC::symtab placeholders;
   Leaves leaves;
+  std::map<GiNaC::ex, detail::Leaf, GiNaC::ex_is_less> spans;
   std::string rewritten;
   for (std::size_t k = 0; k + 1 < tokens.size(); ++k) {
     const Token& tok = tokens[k];
@@ -412,6 +459,7 @@ GiNaC::ex parse_checked(const Model& model, const std::string& text,
     else if (tok.text == "Euler") leaves.values[placeholder] = GiNaC::Euler;
     else if (tok.text == "Catalan") leaves.values[placeholder] = GiNaC::Catalan;
     else leaves.values[placeholder] = model.symbol_table().at(tok.text);
+    spans[placeholder] = {leaves.values[placeholder], tok.pos, tok.pos + tok.text.size(), spans.size()};
     rewritten += name + ' ';
   }
   GiNaC::ex tree;
@@ -423,7 +471,19 @@ GiNaC::ex parse_checked(const Model& model, const std::string& text,
     // Not expected after the checks above (but 'a^b^c'); report GiNaC's own words.
     throw ExpressionError(0, std::string("bad expression: ") + e.what());
   }
-  return Rebuild(leaves)(tree);
+  const GiNaC::ex value = Rebuild(leaves)(tree);
+  detail::SiteLocator at(text, std::move(spans), calls_of(tokens));
+  try {
+    detail::check_constants(at, tree, value);
+    if (extras && extras->linear_inputs)
+      detail::check_linear_inputs(at, tree, value, model.input_symbols());
+    if (extras) detail::collect_sites(at, tree, extras->sites);
+  } catch (const detail::SiteError& e) {
+    throw ExpressionError(e.offset, e.message);
+  } catch (const detail::EvaluationError& e) {  // a part whose value GiNaC refuses
+    throw ExpressionError(0, std::string("bad expression: ") + e.what());
+  }
+  return value;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -488,19 +548,30 @@ class DocumentMarks : public YAML::EventHandler {
   void OnDocumentStart(const YAML::Mark&) override { root_seen_ = false; }
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark& m, YAML::anchor_t) override { root(m, true); }
-  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { root(m, false); }
-  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string&) override {
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t a) override {
     root(m, false);
+    if (anchored.count(a)) aliases[key(anchored[a])].push_back(m);
   }
-  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t a, const std::string&) override {
+    root(m, false);
+    anchor(m, a);
+  }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t a,
                        YAML::EmitterStyle::value) override {
     root(m, false);
+    anchor(m, a);
   }
   void OnSequenceEnd() override {}
-  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t,
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t a,
                   YAML::EmitterStyle::value) override {
     root(m, false);
+    anchor(m, a);
   }
+
+  using Key = std::pair<int, int>;  // line, column
+  static Key key(const YAML::Mark& m) { return {m.line, m.column}; }
+  /// The aliases of each anchored node (by the node's place), in document order.
+  std::map<Key, std::vector<YAML::Mark>> aliases;
   void OnMapEnd() override {}
 
   // The mark of the current document's root node and whether it is an empty (null) node.
@@ -508,6 +579,10 @@ class DocumentMarks : public YAML::EventHandler {
   bool null_root = false;
 
  private:
+  void anchor(const YAML::Mark& m, YAML::anchor_t a) {
+    if (a != 0) anchored[a] = m;
+  }
+  std::map<YAML::anchor_t, YAML::Mark> anchored;
   void root(const YAML::Mark& m, bool is_null) {
     if (root_seen_) return;
     root_seen_ = true;
@@ -517,7 +592,8 @@ class DocumentMarks : public YAML::EventHandler {
   bool root_seen_ = false;
 };
 
-std::vector<YAML::Mark> document_marks(const std::string& text) {
+std::vector<YAML::Mark> document_marks(const std::string& text,
+                                       std::map<DocumentMarks::Key, std::vector<YAML::Mark>>& aliases) {
   std::istringstream in(text);
   YAML::Parser parser(in);
   DocumentMarks handler;
@@ -533,6 +609,7 @@ std::vector<YAML::Mark> document_marks(const std::string& text) {
     previous_null = handler.null_root;
     marks.push_back(handler.mark);
   }
+  aliases = handler.aliases;
   return marks;
 }
 
@@ -543,6 +620,8 @@ class Reader {
   Model read();
 
  private:
+  YAML::Node load();
+  Model read_model();
   using Fields = std::map<std::string, Entry>;
 
   SourceLocation loc(const YAML::Node& n) const {
@@ -566,6 +645,26 @@ class Reader {
     if (text_.compare(pos + shift, v.size(), v) != 0) return where;  // escapes or folded lines
     if (shift && text_[pos + shift + v.size()] != quote) return where;
     where.column += static_cast<int>(shift + offset);
+    return where;
+  }
+
+  // The place of an element read from node `n`: the node's, or, when `n` is read again through
+  // an alias (`- *b`), that alias's, so that a duplicate points at the alias.
+  SourceLocation element_loc(const YAML::Node& n) {
+    const YAML::Mark m = n.Mark();
+    auto it = aliases_.find({m.line, m.column});
+    const std::size_t k = reads_[{m.line, m.column}]++;
+    if (it == aliases_.end() || k == 0 || k > it->second.size()) return loc(n);
+    const YAML::Mark& a = it->second[k - 1];
+    SourceLocation where{file_, a.line + 1, a.column + 1};
+    std::string name;
+    for (std::size_t p = static_cast<std::size_t>(std::max(a.pos, 0)) + 1;
+         p < text_.size() && !std::isspace(static_cast<unsigned char>(text_[p])) &&
+         std::string(",]}").find(text_[p]) == std::string::npos;
+         ++p)
+      name += text_[p];
+    alias_notes_[where.str()] = " (through the alias '*" + name + "', which repeats the node at " +
+                                loc(n).str() + ")";
     return where;
   }
 
@@ -644,8 +743,16 @@ class Reader {
         throw ExpressionError(tok.pos, what + " " + scope_phrase(scope) + "; '" + tok.text +
                                            "' is " + kind_name(it->second));
     };
+    ParseExtras extras;
+    extras.linear_inputs = scope == Scope::any;
     try {
-      return parse_checked(*model_, n.Scalar(), check);
+      const GiNaC::ex e = parse_checked(*model_, n.Scalar(), check, &extras);
+      // Where each call and power of a state-dependent expression was written, for the checks
+      // of derivatives at the operating point (Model::validate).
+      if (scope != Scope::constants && scope != Scope::parameters)
+        for (const auto& site : extras.sites)
+          model_->add_call_site(site.node, {site.text, loc_in_scalar(n, site.offset)});
+      return e;
     } catch (const ExpressionError& e) {
       throw ModelError(loc_in_scalar(n, e.offset()), e.what());
     }
@@ -764,23 +871,59 @@ class Reader {
   Model* model_ = nullptr;
   std::map<std::string, SymbolKind> kinds_;
   std::set<std::string> used_names_;  // bodies, markers, forces, outputs
+  std::map<DocumentMarks::Key, std::vector<YAML::Mark>> aliases_;  // see element_loc
+  std::map<DocumentMarks::Key, std::size_t> reads_;
+  std::map<std::string, std::string> alias_notes_;  // alias location → what it repeats
 };
 
+// The first tab in the indentation of line `line` (0-based) or of the line before it, which
+// yaml-cpp reports in its own words ("illegal block entry", "end of map not found"); {} when
+// there is none. Comment lines may be indented with tabs.
+SourceLocation tab_in_indentation(const std::string& text, int line, const std::string& file) {
+  std::vector<std::size_t> starts{0};
+  for (std::size_t i = 0; i < text.size(); ++i)
+    if (text[i] == '\n') starts.push_back(i + 1);
+  for (int l = std::max(line - 1, 0); l <= line && l < static_cast<int>(starts.size()); ++l) {
+    const std::size_t begin = starts[static_cast<std::size_t>(l)];
+    std::size_t i = begin;
+    while (i < text.size() && (text[i] == ' ' || text[i] == '\t')) ++i;
+    if (i == text.size() || text[i] == '\n' || text[i] == '\r' || text[i] == '#') continue;
+    const std::size_t tab = text.find('\t', begin);
+    if (tab < i) return {file, l + 1, static_cast<int>(tab - begin) + 1};
+  }
+  return {};
+}
+
 Model Reader::read() {
-  YAML::Node root;
   try {
-    const std::vector<YAML::Mark> documents = document_marks(text_);
+    return read_model();
+  } catch (const ModelError& e) {
+    const auto note = alias_notes_.find(e.where().str());
+    if (note == alias_notes_.end()) throw;
+    throw ModelError(e.where(), e.message() + note->second);
+  }
+}
+
+YAML::Node Reader::load() {
+  try {
+    const std::vector<YAML::Mark> documents = document_marks(text_, aliases_);
     if (documents.size() > 1) {
       const YAML::Mark& m = documents[1];
       throw ModelError({file_, m.line + 1, m.column + 1}, "a model file holds one YAML document");
     }
-    root = YAML::Load(text_);
+    return YAML::Load(text_);
   } catch (const YAML::DeepRecursion& e) {
     throw ModelError({file_, e.mark.line + 1, e.mark.column + 1},
                      "YAML nested too deeply (" + std::to_string(e.depth()) + " levels)");
   } catch (const YAML::Exception& e) {
+    const SourceLocation tab = tab_in_indentation(text_, e.mark.line, file_);
+    if (tab.line > 0) throw ModelError(tab, "tab in indentation; YAML allows only spaces");
     throw ModelError({file_, e.mark.line + 1, e.mark.column + 1}, e.msg);
   }
+}
+
+Model Reader::read_model() {
+  const YAML::Node root = load();
   if (root.IsNull())
     throw ModelError({file_, 1, 1}, "the model file is empty (expected a map starting with "
                                     "'model: NAME')");
@@ -793,6 +936,11 @@ Model Reader::read() {
   if (!is_identifier(model_name))
     fail(name_entry.value, "the model name '" + model_name +
                                "' must be an identifier (letters, digits and _)");
+  if (reserved_identifier(model_name))
+    fail(name_entry.value, "the model name '" + model_name +
+                               "' is a C++ keyword or a name C++ reserves (such as int, class, "
+                               "std, linux): the generated code names its kernels after the "
+                               "model; choose another name");
   Model model(model_name);
   model_ = &model;
 
@@ -876,11 +1024,11 @@ void Reader::read_named_list(const Entry* e, const std::string& what, bool coord
       item_name = scalar(n, "a name or {name, unit} in " + what);
     }
     if (coordinates) {
-      model_->add_coordinate(item_name, unit, loc(n));
+      model_->add_coordinate(item_name, unit, element_loc(n));
       define(SymbolKind::coordinate, item_name);
       define(SymbolKind::rate, item_name + "_dot");
     } else {
-      model_->add_input(item_name, unit, loc(n));
+      model_->add_input(item_name, unit, element_loc(n));
       define(SymbolKind::input, item_name);
     }
   }
@@ -892,7 +1040,7 @@ void Reader::read_body(const YAML::Node& n, const std::set<std::string>& all_bod
                            "com", "inertia", "markers"});
   Body b;
   b.name = name(require(f, "name", n, "a body"), "a body name");
-  b.where = loc(n);
+  b.where = element_loc(n);
   const std::string what = "body '" + b.name + "'";
   if (const Entry* p = find(f, "parent")) {
     const YAML::Node& pn = value(*p);
@@ -973,7 +1121,7 @@ void Reader::read_marker(const YAML::Node& n, const std::string& body, const YAM
   const Fields f = fields(n, "a marker", keys);
   Marker m;
   m.name = name(require(f, "name", n, "a marker"), "a marker name");
-  m.where = loc(n);
+  m.where = element_loc(n);
   m.body = on_body ? body : std::string(kWorld);
   if (const Entry* b = find(f, "body")) {
     const YAML::Node& bn = value(*b);
@@ -1030,7 +1178,7 @@ void Reader::read_force(const YAML::Node& n, std::map<std::string, int>& counter
     while (used_names_.count(force_name));
   }
   used_names_.insert(force_name);
-  const SourceLocation where = loc(n);
+  const SourceLocation where = element_loc(n);
 
   std::string marker_a, marker_b;
   if (const Entry* e = find(f, "between")) {
@@ -1057,8 +1205,13 @@ void Reader::read_force(const YAML::Node& n, std::map<std::string, int>& counter
     s.marker_a = marker_a;
     s.marker_b = marker_b;
     s.stiffness = expr(require(f, "stiffness", n, what), "a spring stiffness", Scope::parameters);
-    if (const Entry* e = find(f, "rest_length"))
+    if (const Entry* e = find(f, "rest_length")) {
       s.rest_length = expr(*e, "a rest length", Scope::parameters);
+      const GiNaC::ex L0 = evaluate(value(*e), s.rest_length, parameter_values());
+      if (GiNaC::is_a<GiNaC::numeric>(L0) && GiNaC::ex_to<GiNaC::numeric>(L0).is_negative())
+        fail(value(*e), "a rest length must be >= 0, got " +
+                            detail::checked_subs_impl::describe(GiNaC::ex_to<GiNaC::numeric>(L0)) + " m");
+    }
     s.where = where;
     model_->add_spring(s);
   } else if (type == "damper") {
@@ -1148,7 +1301,7 @@ void Reader::read_output(const YAML::Node& n) {
   const Fields f = fields(n, what, keys);
   Output o;
   o.name = name(require(f, "name", n, what), "an output name");
-  o.where = loc(n);
+  o.where = element_loc(n);
   if (const Entry* u = find(f, "unit")) o.unit = scalar(value(*u), "a unit");
   if (type == "position" || type == "velocity") {
     o.kind = type == "position" ? OutputKind::position : OutputKind::velocity;

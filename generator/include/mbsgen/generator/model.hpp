@@ -283,6 +283,14 @@ struct Coordinate {
   SourceLocation where;
 };
 
+/// Where a function call or a power of an expression was written (`text` as written, such as
+/// `abs(x_dot)`), so that validate() can point at it when its derivative does not exist at the
+/// operating point.
+struct CallSite {
+  std::string text;
+  SourceLocation where;
+};
+
 class Model;
 /// The model as one of its scenes sees it (scene.hpp).
 Model apply_scene(const Model& model, const std::string& scene);
@@ -314,6 +322,14 @@ class Model {
   void set_operating_point(OperatingPoint op) { operating_point_ = std::move(op); }
   /// Adds a scene; its references are checked by validate().
   void add_scene(Scene scene);
+  /// Records where the subexpression `node` (a call or power) was written; the first record of
+  /// equal nodes is kept. Optional: without it validate() reports at the element.
+  void add_call_site(const GiNaC::ex& node, CallSite site) { call_sites_.emplace(node, std::move(site)); }
+  /// The record of add_call_site for `node`, or nullptr.
+  const CallSite* call_site(const GiNaC::ex& node) const {
+    auto it = call_sites_.find(node);
+    return it == call_sites_.end() ? nullptr : &it->second;
+  }
   /// False drops the velocity-quadratic inertia terms (gyroscopic, centrifugal and Coriolis
   /// forces) from k(y, ẏ); apply_scene() does so when a scene deactivates them or linearizes
   /// about rest, where they cannot contribute.
@@ -353,8 +369,14 @@ class Model {
   bool has_marker(const std::string& name) const;
 
   /// Checks references (parents, markers, coordinates), the tree (no cycles, every body reaches
-  /// the world), masses and inertias, that every expression uses only known symbols, and every
-  /// scene (check_scene in scene.hpp). Throws ModelError at the offending element.
+  /// the world), masses and inertias (a physical tensor, decided exactly when its entries are
+  /// rational at the default parameter values), rest lengths (>= 0), that every expression uses
+  /// only known symbols, that inputs enter forces linearly, every scene (check_scene in
+  /// scene.hpp), and, at a given operating point with the default parameter values, that every
+  /// call and power of a state-dependent expression has the derivatives the linear model needs
+  /// (not abs(x_dot) at x_dot = 0, sqrt(x) at x = 0) and that no spring (of nonzero rest length)
+  /// or damper joins two coincident points. Throws ModelError at the offending element (at the
+  /// call, when add_call_site recorded it).
   void validate() const;
 
  private:
@@ -386,6 +408,7 @@ class Model {
   std::map<std::string, int> marker_index_;
   std::map<std::string, SourceLocation> symbol_names_;  // parameters, coordinates, rates, inputs
   std::map<std::string, std::pair<std::string, SourceLocation>> element_names_;  // name → kind
+  std::map<GiNaC::ex, CallSite, GiNaC::ex_is_less> call_sites_;
 };
 
 }  // namespace mbsgen
