@@ -219,7 +219,8 @@ inline void check_constants(SiteLocator& at, const GiNaC::ex& tree, const GiNaC:
 // Inputs enter linearly
 
 /// Whether `e` is linear in the symbol u: u occurs in no function and in no power other than
-/// a non-negative integer one, and ∂²e/∂u² = 0.
+/// a non-negative integer one, and ∂²e/∂u² = 0 (expanded: powers of u above 8 are called
+/// nonlinear without expanding, so that (x + y + u)^1000 cannot make it slow).
 inline bool linear_in(const GiNaC::ex& e, const GiNaC::symbol& u) {
   if (!e.has(u)) return true;
   for (GiNaC::const_preorder_iterator i = e.preorder_begin(); i != e.preorder_end(); ++i) {
@@ -227,7 +228,8 @@ inline bool linear_in(const GiNaC::ex& e, const GiNaC::symbol& u) {
     if (GiNaC::is_a<GiNaC::function>(*i)) return false;
     if (GiNaC::is_a<GiNaC::power>(*i)) {
       const GiNaC::ex n = i->op(1);
-      if (n.has(u) || !GiNaC::is_a<GiNaC::numeric>(n) || !GiNaC::ex_to<GiNaC::numeric>(n).is_nonneg_integer())
+      if (n.has(u) || !GiNaC::is_a<GiNaC::numeric>(n) || !GiNaC::ex_to<GiNaC::numeric>(n).is_nonneg_integer() ||
+          GiNaC::ex_to<GiNaC::numeric>(n) > 8)
         return false;
     }
   }
@@ -270,9 +272,10 @@ inline std::optional<GiNaC::ex> nonlinear_part(SiteLocator& at, const GiNaC::ex&
 inline void check_linear_inputs(SiteLocator& at, const GiNaC::ex& tree, const GiNaC::ex& whole,
                                 const std::vector<GiNaC::symbol>& inputs) {
   for (const GiNaC::symbol& u : inputs) {
-    if (linear_in(whole, u)) continue;
+    // Linear as written (no part where u enters nonlinearly), or after simplification.
     const std::optional<GiNaC::ex> part = nonlinear_part(at, tree, {u});
-    const ExpressionSite s = part ? at.site(*part) : ExpressionSite{whole, "", 0};
+    if (!part || linear_in(whole, u)) continue;
+    const ExpressionSite s = at.site(*part);
     throw SiteError{s.offset, "input '" + u.get_name() + "' enters nonlinearly" +
                                   (s.text.empty() ? "" : " in " + s.text) +
                                   " (inputs must enter forces linearly, as c*" + u.get_name() +

@@ -202,7 +202,7 @@ inline std::vector<std::optional<NumVec>> marker_positions(const Model& model, c
     if (b.rotation_matrix) R = matrix_at(*b.rotation_matrix, values);
     for (const auto& r : b.rotations) {
       const auto a = number_at(r.angle, values);
-      if (!a || !R) { R.reset(); break; }
+      if (!a || !R || !(GiNaC::abs(*a) < GiNaC::numeric(1000000))) { R.reset(); break; }
       const GiNaC::numeric c = GiNaC::cos(*a), s = GiNaC::sin(*a);
       NumMat m = E;
       const std::size_t i = r.axis == Axis::x ? 1 : r.axis == Axis::y ? 2 : 0, j = (i + 1) % 3;
