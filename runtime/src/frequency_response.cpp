@@ -1154,6 +1154,7 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
                                               const std::vector<Index>& outputs) {
   info_ = Eigen::InvalidInput;
   warnings_.clear();
+  notes_.clear();
   Impl& im = *impl_;
   const Index n = model_.size();
   if (input < 0 || input >= model_.num_inputs()) {
@@ -1207,7 +1208,7 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
         std::ostringstream s;
         s << "FrequencyResponse (hessenberg): forward error " << im.hess_forward_ratio
           << "x direct's at a probe frequency (bar 10x); automatic uses direct";
-        warnings_.push_back(s.str());
+        notes_.push_back(s.str());
         used_ = m = FrfMethod::direct;
         im.prepare_direct();
       } else if (!(im.hess_backward_error <= im.hess_bar)) {
@@ -1219,11 +1220,12 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
           s << "; automatic uses direct";
           used_ = m = FrfMethod::direct;
           im.prepare_direct();
+          notes_.push_back(s.str());
         } else {
           s << "; expect that many fewer correct digits than direct";
           im.select_hessenberg();
+          warnings_.push_back(s.str());
         }
-        warnings_.push_back(s.str());
       } else {
         im.select_hessenberg();
       }

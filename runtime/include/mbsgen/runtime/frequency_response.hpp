@@ -154,6 +154,9 @@ class FrequencyResponse {
   double hessenberg_backward_error() const;
   /// Warnings recorded by the last compute() (e.g. modal without static correction).
   const std::vector<std::string>& warnings() const { return warnings_; }
+  /// Why FrfMethod::automatic replaced hessenberg by direct after its a-posteriori checks (not
+  /// warnings: the result has direct's accuracy; method() names the method used).
+  const std::vector<std::string>& notes() const { return notes_; }
 
  private:
   struct Impl;  // per-method workspaces (frequency_response.cpp)
@@ -166,6 +169,7 @@ class FrequencyResponse {
   Eigen::VectorXd rcond_;
   std::vector<FrfFlag> flags_;
   std::vector<std::string> warnings_;
+  std::vector<std::string> notes_;
 };
 
 /// Amplitude |g| (eq. 3.22).
