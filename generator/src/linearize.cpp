@@ -46,20 +46,7 @@ Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operat
   std::uint64_t state = 0x2545f4914f6cdd1dULL;
   try {
     for (int point = 0; point < 2; ++point) {
-      GiNaC::exmap values;
-      for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p})
-        for (const auto& x : *group) {
-          state ^= state << 13, state ^= state >> 7, state ^= state << 17;  // xorshift64
-          values[x] = GiNaC::numeric(static_cast<long>(state % 2000000) + 500000, 1000000);
-        }
-      if (at_operating_point) {
-        GiNaC::exmap p;
-        for (const auto& x : eq.p) p[x] = values[x];
-        for (std::size_t k = 0; k < f; ++k) {
-          if (!lin.equilibrium) values[eq.y[k]] = GiNaC::evalf(lin.y0[k].subs(p, GiNaC::subs_options::no_pattern));
-          values[eq.yd[k]] = GiNaC::evalf(lin.yd0[k].subs(p, GiNaC::subs_options::no_pattern));
-        }
-      }
+      const GiNaC::exmap values = detail::sample_point(eq, lin, state, at_operating_point);
       const std::vector<GiNaC::numeric> v = detail::PointEvaluator(eq.program, values).evaluate(entries);
       const GiNaC::numeric zero = 0;
       auto at = [&](std::size_t matrix, std::size_t i, std::size_t j) -> const GiNaC::numeric& {

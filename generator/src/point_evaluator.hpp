@@ -3,7 +3,10 @@
 #pragma once
 
 #include "checked_subs.hpp"
+#include "mbsgen/generator/linearize.hpp"
 #include "mbsgen/generator/program.hpp"
+
+#include <cstdint>
 
 #include <stdexcept>
 #include <unordered_map>
@@ -94,5 +97,29 @@ class PointEvaluator {
   const Program& prog_;
   std::unordered_map<ex, GiNaC::numeric, std::hash<ex>, GiNaC::ex_is_equal> values_;
 };
+
+/// A pseudo-random point for the structure tests of the linear matrices (linearize.cpp,
+/// structural_zeros.cpp): every coordinate, rate, input and parameter uniform in [0.5, 2.5)
+/// (exact rationals from the xorshift64 sequence in `state`, advanced); with at_operating_point,
+/// the rates, and for a `given` operating point the coordinates, at the operating point of those
+/// parameters (an equilibrium's coordinates stay free: they are known only numerically).
+inline GiNaC::exmap sample_point(const Equations& eq, const LinearEquations& lin, std::uint64_t& state,
+                                 bool at_operating_point) {
+  GiNaC::exmap values;
+  for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p})
+    for (const auto& x : *group) {
+      state ^= state << 13, state ^= state >> 7, state ^= state << 17;  // xorshift64
+      values[x] = GiNaC::numeric(static_cast<long>(state % 2000000) + 500000, 1000000);
+    }
+  if (at_operating_point) {
+    GiNaC::exmap p;
+    for (const auto& x : eq.p) p[x] = values[x];
+    for (std::size_t k = 0; k < eq.y.size(); ++k) {
+      if (!lin.equilibrium) values[eq.y[k]] = GiNaC::evalf(lin.y0[k].subs(p, GiNaC::subs_options::no_pattern));
+      values[eq.yd[k]] = GiNaC::evalf(lin.yd0[k].subs(p, GiNaC::subs_options::no_pattern));
+    }
+  }
+  return values;
+}
 
 }  // namespace mbsgen::detail

@@ -57,20 +57,8 @@ std::vector<ZeroPattern> screen(Equations& eq, LinearEquations& lin, StructuralZ
   std::uint64_t state = at_operating_point ? 0x9e3779b97f4a7c15ULL : 0x2545f4914f6cdd1dULL;
   try {
     for (int point = 0; point < 2; ++point) {
-      GiNaC::exmap values;
-      for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p})
-        for (const auto& x : *group) {
-          state ^= state << 13, state ^= state >> 7, state ^= state << 17;  // xorshift64
-          values[x] = GiNaC::numeric(static_cast<long>(state % 2000000) + 500000, 1000000);
-        }
-      if (at_operating_point) {
-        GiNaC::exmap p;
-        for (const auto& x : eq.p) p[x] = values[x];
-        for (std::size_t k = 0; k < eq.y.size(); ++k) {
-          values[eq.y[k]] = GiNaC::evalf(lin.y0[k].subs(p, GiNaC::subs_options::no_pattern));
-          values[eq.yd[k]] = GiNaC::evalf(lin.yd0[k].subs(p, GiNaC::subs_options::no_pattern));
-        }
-      }
+      // (Called with at_operating_point only for a given operating point.)
+      const GiNaC::exmap values = detail::sample_point(eq, lin, state, at_operating_point);
       const std::vector<GiNaC::numeric> v = detail::PointEvaluator(eq.program, values).evaluate(entries);
       std::size_t at = 0;
       for (std::size_t m = 0; m < ts.size(); ++m) {

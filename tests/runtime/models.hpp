@@ -8,6 +8,8 @@
 #include <limits>
 #include <vector>
 
+#include "mbsgen/runtime/frequency_response.hpp"
+
 namespace testmodels {
 
 /// Unit roundoff u = 2⁻⁵³.
@@ -254,6 +256,21 @@ inline Qep with_noise_in_zeros(Qep p, std::uint64_t seed = 3) {
       }
   }
   return p;
+}
+
+/// count angular frequencies [rad/s] log-spaced from f0_hz to f1_hz (both included).
+inline Eigen::VectorXd log_omegas(double f0_hz, double f1_hz, int count) {
+  constexpr double kTwoPi = 6.283185307179586;
+  Eigen::VectorXd w(count);
+  for (int k = 0; k < count; ++k) w[k] = kTwoPi * f0_hz * std::pow(f1_hz / f0_hz, k / double(count - 1));
+  return w;
+}
+
+/// Frequency-response options with the given method, the rest default.
+inline mbsgen::FrfOptions with(mbsgen::FrfMethod method) {
+  mbsgen::FrfOptions o;
+  o.method = method;
+  return o;
 }
 
 }  // namespace testmodels

@@ -16,19 +16,15 @@ using testmodels::Qep;
 using testmodels::u;
 using cd = std::complex<double>;
 
+using testmodels::log_omegas;
+using testmodels::with;
+
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
 
 /// The bar for direct and hessenberg where the problem is well conditioned.
 constexpr double kBar = 1e-10;
-
-Eigen::VectorXd log_omegas(double f0_hz, double f1_hz, int count) {
-  Eigen::VectorXd w(count);
-  for (int k = 0; k < count; ++k)
-    w[k] = kTwoPi * f0_hz * std::pow(f1_hz / f0_hz, k / double(count - 1));
-  return w;
-}
 
 LinearModel model_of(const Qep& p) { return LinearModel(p.M, p.Q, p.K); }
 
@@ -64,12 +60,6 @@ double check_method(const LinearModel& m, FrfOptions opt, const Eigen::VectorXd&
                       << f.rcond()[k];
   }
   return worst;
-}
-
-FrfOptions with(FrfMethod m) {
-  FrfOptions o;
-  o.method = m;
-  return o;
 }
 
 }  // namespace

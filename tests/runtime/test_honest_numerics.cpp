@@ -20,16 +20,12 @@ using testmodels::Qep;
 using testmodels::u;
 using cd = std::complex<double>;
 
+using testmodels::log_omegas;
+using testmodels::with;
+
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
-
-Eigen::VectorXd log_omegas(double f0_hz, double f1_hz, int count) {
-  Eigen::VectorXd w(count);
-  for (int k = 0; k < count; ++k)
-    w[k] = kTwoPi * f0_hz * std::pow(f1_hz / f0_hz, k / double(count - 1));
-  return w;
-}
 
 /// Largest normwise relative error over the frequencies of the response to input 0 (outputs =
 /// coordinates) against the 266-bit solve; flagged poles count as an error of 1.
@@ -62,12 +58,6 @@ Outcome run(const LinearModel& m, FrfMethod method, const Eigen::VectorXd& w) {
   int flagged = 0;
   for (FrfFlag fl : f.flags()) flagged += fl != FrfFlag::ok;
   return {f.method(), worst_error(m, f, w), flagged};
-}
-
-FrfOptions with(FrfMethod m) {
-  FrfOptions o;
-  o.method = m;
-  return o;
 }
 
 }  // namespace

@@ -34,6 +34,8 @@ using mbsgen::QuadraticEigenSolver;
 using testmodels::u;
 using cd = std::complex<double>;
 
+using testmodels::log_omegas;
+
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
@@ -98,13 +100,6 @@ std::string sci(double x) {
   std::ostringstream s;
   s << x;
   return s.str();
-}
-
-Eigen::VectorXd log_omegas(double f0_hz, double f1_hz, int count) {
-  Eigen::VectorXd w(count);
-  for (int k = 0; k < count; ++k)
-    w[k] = kTwoPi * f0_hz * std::pow(f1_hz / f0_hz, k / double(count - 1));
-  return w;
 }
 
 }  // namespace

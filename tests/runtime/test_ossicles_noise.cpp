@@ -12,6 +12,7 @@
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/linear_model.hpp"
 #include "mbsgen/runtime/matrix_market.hpp"
+#include "models.hpp"
 
 namespace {
 
@@ -45,8 +46,7 @@ double error(const mbsgen::LinearModel& m, std::complex<double> z, double omega)
 TEST(OssiclesWithNoisyZeros, AutomaticMethodKeepsTheAccuracyOfDirect) {
   const mbsgen::LinearModel m = noisy_ossicles();
   const int F = 30;
-  Eigen::VectorXd omega(F);
-  for (int k = 0; k < F; ++k) omega[k] = 2 * M_PI * 100 * std::pow(100.0, k / (F - 1.0));
+  const Eigen::VectorXd omega = testmodels::log_omegas(100, 10000, F);
   mbsgen::FrfOptions automatic, direct;
   direct.method = mbsgen::FrfMethod::direct;
   mbsgen::FrequencyResponse fa(m, automatic), fd(m, direct);
