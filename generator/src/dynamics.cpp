@@ -204,6 +204,8 @@ Equations derive(const Model& model, const DeriveOptions& options) {
       case OutputKind::expression:
         eq.outputs.push_back(o.expression);
         break;
+      case OutputKind::force:  // element forces: being built (issue 15)
+        throw ModelError(o.where, "output '" + o.name + "': force outputs are not derived yet");
     }
   }
 

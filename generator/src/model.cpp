@@ -65,6 +65,18 @@ const char* to_string(Analysis analysis) {
   return "";
 }
 
+const char* to_string(ConstraintKind kind) {
+  switch (kind) {
+    case ConstraintKind::spherical: return "spherical";
+    case ConstraintKind::revolute: return "revolute";
+    case ConstraintKind::prismatic: return "prismatic";
+    case ConstraintKind::planar: return "planar";
+    case ConstraintKind::distance: return "distance";
+    case ConstraintKind::expression: return "expression";
+  }
+  return "";
+}
+
 Model::Model(std::string name) : name_(std::move(name)) {}
 
 void Model::check_new_symbol(const std::string& name, const SourceLocation& where) {
@@ -178,6 +190,11 @@ void Model::add_applied_force(AppliedForce force) {
 void Model::add_output(Output output) {
   check_new_element(output.name, "output", output.where);
   outputs_.push_back(std::move(output));
+}
+
+void Model::add_constraint(Constraint constraint) {
+  check_new_element(constraint.name, "constraint", constraint.where);
+  constraints_.push_back(std::move(constraint));
 }
 
 void Model::add_scene(Scene scene) {
@@ -354,6 +371,80 @@ std::string inertia_problem(const Mat3& I, const GiNaC::exmap& defaults, const G
 
 }  // namespace
 
+// A force output names force elements that transmit a force between two markers.
+void Model::validate_force_output(const Output& o) const {
+  if (o.elements.empty())
+    throw ModelError(o.where, "output '" + o.name + "' of type force names no force element");
+  std::set<std::string> seen;
+  for (const auto& e : o.elements) {
+    if (!seen.insert(e).second)
+      throw ModelError(o.where, "output '" + o.name + "' names force element '" + e + "' twice");
+    bool found = false;
+    for (const auto& s : springs_) found = found || s.name == e;
+    for (const auto& d : dampers_) found = found || d.name == e;
+    for (const auto& b : bushings_) found = found || b.name == e;
+    if (!found)
+      throw ModelError(o.where, "output '" + o.name + "' names '" + e +
+                                    "', which is not a spring, damper or bushing of this model");
+  }
+}
+
+// Loop-closure constraints: markers on two different bodies, a positive rod length, expressions
+// in coordinates and parameters that depend on a coordinate; the independent coordinates exist
+// once each; and the operating point is at rest (steady motions of closed loops are not
+// linearized: see loop_closure.hpp).
+void Model::validate_constraints(const GiNaC::exmap& defaults) const {
+  std::set<std::string> position_only, parameters_only;
+  for (const auto& p : parameters_) position_only.insert(p.name), parameters_only.insert(p.name);
+  for (const auto& c : coordinates_) position_only.insert(c.name);
+  auto check_symbols = [&](const GiNaC::ex& e, const SourceLocation& where, const std::string& what,
+                           const std::set<std::string>& allowed) {
+    std::set<std::string> syms;
+    collect_symbols(e, syms);
+    for (const auto& s : syms)
+      if (!allowed.count(s)) throw ModelError(where, what + " may not depend on '" + s + "'");
+  };
+  for (const auto& c : constraints_) {
+    const std::string who = std::string(to_string(c.kind)) + " constraint '" + c.name + "'";
+    if (c.kind == ConstraintKind::expression) {
+      check_symbols(c.expression, c.where, "a constraint expression", position_only);
+      bool depends = false;
+      for (const auto& y : coordinates_) depends = depends || c.expression.has(y.position);
+      if (!depends)
+        throw ModelError(c.where, who + " does not depend on any coordinate");
+      continue;
+    }
+    for (const std::string* m : {&c.marker_a, &c.marker_b})
+      if (!has_marker(*m)) throw ModelError(c.where, who + " names an unknown marker '" + *m + "'");
+    if (marker(c.marker_a).body == marker(c.marker_b).body)
+      throw ModelError(c.where, who + " joins two markers of the same body '" + marker(c.marker_a).body +
+                                    "': a constraint closes a loop between two bodies");
+    if (c.kind == ConstraintKind::distance) {
+      check_symbols(c.length, c.where, "a rod length", parameters_only);
+      bool ok = false;
+      const double L = numeric_value(c.length, defaults, ok);
+      if (!ok || !(L > 0))
+        throw ModelError(c.where, who + " needs a positive length (" +
+                                      (ok ? detail::checked_subs_impl::describe(GiNaC::numeric(L)) + " m"
+                                          : std::string("not a number")) + " with the default parameter values)");
+    }
+  }
+  std::set<std::string> independent;
+  for (const auto& item : independent_) {
+    if (constraints_.empty())
+      throw ModelError(item.where, "independent coordinates are chosen only in a model with constraints");
+    if (coordinate_index(item.name) < 0)
+      throw ModelError(item.where, "independent coordinate '" + item.name + "' is not a coordinate");
+    if (!independent.insert(item.name).second)
+      throw ModelError(item.where, "independent coordinate '" + item.name + "' is listed twice");
+  }
+  if (!constraints_.empty())
+    for (const auto& [name, value] : operating_point_.velocity)
+      if (!value.is_zero())
+        throw ModelError(operating_point_.where, "a model with constraints is linearized at rest; the steady rate of '" +
+                                                     name + "' must be 0 (steady motions of closed loops are not supported)");
+}
+
 void Model::validate() const {
   std::set<std::string> known;
   for (const auto& [name, sym] : symtab_) known.insert(name);
@@ -475,8 +566,13 @@ void Model::validate() const {
         check_expr(o.expression, o.where, "an output expression", allowed);
         break;
       }
+      case OutputKind::force:
+        validate_force_output(o);
+        for (const auto& x : o.direction) check_expr(x, o.where, "an output direction", parameters_only);
+        break;
     }
   }
+  validate_constraints(defaults);
   for (const auto& [name, value] : operating_point_.position) {
     if (coordinate_index(name) < 0)
       throw ModelError(operating_point_.where, "operating point names an unknown coordinate '" + name + "'");

@@ -156,7 +156,39 @@ struct Input {
   SourceLocation where;
 };
 
-enum class OutputKind { position, velocity, coordinate, rate, expression };
+/// A holonomic constraint Φ(y) = 0 that closes a kinematic loop (docs/model-format.md,
+/// "constraints"). The joint kinds act between the points and frames of two markers on different
+/// bodies (or a body and the world), with d = r_b − r_a and (x_a, y_a, z_a), (x_b, y_b, z_b) the
+/// axes of the marker frames, all in the world frame:
+///   spherical  d = 0                                            (3 equations)
+///   revolute   d = 0, z_b·x_a = 0, z_b·y_a = 0                  (5: the z axes stay aligned)
+///   prismatic  d·x_a = 0, d·y_a = 0, y_b·z_a = 0, z_b·x_a = 0, x_b·y_a = 0
+///                                         (5: slides along z_a, the frames keep their orientation)
+///   planar     d·z_a = 0, z_b·x_a = 0, z_b·y_a = 0               (3: b moves in a's x–y plane)
+///   distance   (d·d − L²)/(2L) = 0                               (1: a massless rigid rod of length L)
+///   expression Φ = expression                                   (1: any expression in coordinates
+///                                                                and parameters)
+/// The joint equations are scaled so that their multipliers λ are the reaction forces [N] and
+/// torques [N m] in the world frame. Equations that vanish identically (a 3-D joint in a planar
+/// model) are dropped.
+enum class ConstraintKind { spherical, revolute, prismatic, planar, distance, expression };
+
+/// "spherical", "revolute", "prismatic", "planar", "distance", "expression".
+const char* to_string(ConstraintKind kind);
+
+struct Constraint {
+  std::string name;
+  ConstraintKind kind = ConstraintKind::spherical;
+  std::string marker_a, marker_b;  ///< every kind but expression
+  GiNaC::ex length;                ///< distance: L [m] (> 0)
+  GiNaC::ex expression;            ///< expression: Φ (in coordinates and parameters)
+  SourceLocation where;
+};
+
+enum class OutputKind { position, velocity, coordinate, rate, expression, force };
+
+/// What a `force` output measures of its force elements.
+enum class ForceQuantity { force, torque };
 
 /// A measured quantity z(y, ẏ); its linearization gives a row of C_y and C_v.
 struct Output {
@@ -166,6 +198,13 @@ struct Output {
   Vec3 direction = zero_vec3();     ///< world frame, position and velocity
   std::string coordinate;           ///< coordinate, rate
   GiNaC::ex expression;             ///< expression
+  /// force: the force [N] (or torque [N m], about the point of marker b) that the named force
+  /// elements (springs, dampers, bushings) exert on the body of their marker b, summed, as
+  /// directionᵀ (that vector) with direction in the world frame, or in the frame of marker b of
+  /// the first element when force_frame is marker.
+  std::vector<std::string> elements;
+  ForceQuantity quantity = ForceQuantity::force;
+  ForceFrame force_frame = ForceFrame::world;
   std::string unit;
   SourceLocation where;
 };
@@ -319,6 +358,12 @@ class Model {
   void add_generalized_force(GeneralizedForce force);
   void add_applied_force(AppliedForce force);
   void add_output(Output output);
+  /// A loop-closure constraint (validate() checks its markers and symbols).
+  void add_constraint(Constraint constraint);
+  /// The coordinates the linear model keeps (the rest are dependent, found from the
+  /// constraints); when not set, the generator chooses them by pivoted QR of the constraint
+  /// Jacobian at the operating point (loop_closure.hpp).
+  void set_independent_coordinates(std::vector<SceneItem> names) { independent_ = std::move(names); }
   void set_operating_point(OperatingPoint op) { operating_point_ = std::move(op); }
   /// Adds a scene; its references are checked by validate().
   void add_scene(Scene scene);
@@ -353,6 +398,8 @@ class Model {
   const std::vector<GeneralizedForce>& generalized_forces() const { return generalized_forces_; }
   const std::vector<AppliedForce>& applied_forces() const { return applied_forces_; }
   const std::vector<Output>& outputs() const { return outputs_; }
+  const std::vector<Constraint>& constraints() const { return constraints_; }
+  const std::vector<SceneItem>& independent_coordinates() const { return independent_; }
   const OperatingPoint& operating_point() const { return operating_point_; }
   const std::vector<Scene>& scenes() const { return scenes_; }
   /// The scene of that name, or nullptr (also for the implicit "full").
@@ -384,6 +431,8 @@ class Model {
 
   void check_new_symbol(const std::string& name, const SourceLocation& where);
   void check_new_element(const std::string& name, const char* kind, const SourceLocation& where);
+  void validate_force_output(const Output& output) const;
+  void validate_constraints(const GiNaC::exmap& defaults) const;
 
   std::string name_;
   GiNaC::symtab symtab_;
@@ -400,6 +449,8 @@ class Model {
   std::vector<GeneralizedForce> generalized_forces_;
   std::vector<AppliedForce> applied_forces_;
   std::vector<Output> outputs_;
+  std::vector<Constraint> constraints_;
+  std::vector<SceneItem> independent_;
   OperatingPoint operating_point_;
   std::vector<Scene> scenes_;
   bool inertial_velocity_terms_ = true;
