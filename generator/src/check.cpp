@@ -75,15 +75,20 @@ std::vector<std::vector<Eigen::Index>> coupled_blocks(const Eigen::MatrixXd& M) 
 void check_operating_point(const Equations& eq, const LinearEquations& lin) {
   const Model& model = *eq.model;
   if (lin.equilibrium) return;
-  const std::size_t f = eq.y.size();
+  // With closed loops the matrices and the residual are those of the independent coordinates
+  // (f of the n tree coordinates; loop_closure.hpp).
+  const std::size_t n_tree = eq.y.size(), f = eq.M.size();
   const SourceLocation where = where_of(model);
 
   GiNaC::exmap values, p;
   for (std::size_t k = 0; k < eq.p.size(); ++k)
     p[eq.p[k]] = GiNaC::numeric(model.parameters()[k].value);
   values = p;
-  for (std::size_t k = 0; k < f; ++k) {
-    values[eq.y[k]] = lin.y0[k].subs(p, GiNaC::subs_options::no_pattern);
+  for (std::size_t k = 0; k < n_tree; ++k) {
+    auto closed = eq.loops.closed_at_defaults.find(eq.y[k]);
+    values[eq.y[k]] = closed != eq.loops.closed_at_defaults.end()
+                          ? closed->second
+                          : lin.y0[k].subs(p, GiNaC::subs_options::no_pattern);
     values[eq.yd[k]] = lin.yd0[k].subs(p, GiNaC::subs_options::no_pattern);
   }
   for (const auto& u : eq.u) values[u] = 0;
@@ -131,10 +136,13 @@ void check_operating_point(const Equations& eq, const LinearEquations& lin) {
     return A;
   };
   const MatrixXd M = matrix(0), K = matrix(1), Q = matrix(2);
-  VectorXd r(f), y0(f), yd0(f);
+  VectorXd r(f), y0(n_tree), yd0(n_tree);
   for (std::size_t i = 0; i < f; ++i) r(static_cast<Eigen::Index>(i)) = v[3 * f * f + i];
   const auto& coords = model.coordinates();
-  auto coordinate = [&](Eigen::Index i) { return coords[static_cast<std::size_t>(i)].name; };
+  auto index = [&](Eigen::Index i) {
+    return eq.loops.active ? eq.loops.independent[static_cast<std::size_t>(i)] : static_cast<std::size_t>(i);
+  };
+  auto coordinate = [&](Eigen::Index i) { return coords[index(i)].name; };
 
   // M(y0): a zero diagonal entry is a coordinate that moves no mass; otherwise the eigenvalues of
   // the equilibrated matrix (unit diagonal, so between 0 and f) show a singular combination.
@@ -142,7 +150,7 @@ void check_operating_point(const Equations& eq, const LinearEquations& lin) {
   SourceLocation first_massless;
   for (Eigen::Index i = 0; i < M.rows(); ++i)
     if (!(M(i, i) > 0)) {
-      if (massless.empty()) first_massless = coords[static_cast<std::size_t>(i)].where;
+      if (massless.empty()) first_massless = coords[index(i)].where;
       massless.push_back(coordinate(i));
     }
   if (!massless.empty())
@@ -175,7 +183,7 @@ void check_operating_point(const Equations& eq, const LinearEquations& lin) {
   }
 
   // k − q at the operating point, against the scale of the forces the linear model contains.
-  for (std::size_t k = 0; k < f; ++k) {
+  for (std::size_t k = 0; k < n_tree; ++k) {
     const auto i = static_cast<Eigen::Index>(k);
     y0(i) = GiNaC::ex_to<GiNaC::numeric>(GiNaC::evalf(values[eq.y[k]])).to_double();
     yd0(i) = GiNaC::ex_to<GiNaC::numeric>(GiNaC::evalf(values[eq.yd[k]])).to_double();

@@ -53,7 +53,13 @@ struct Rewriter : GiNaC::map_function {
     if (auto it = replaced.find(rep); it != replaced.end()) {
       result = sign * it->second;
     } else if (auto c = counts.find(rep); c != counts.end() && c->second > 1) {
-      ex mapped = map_children(rep);
+      // −e is usually e with its sign absorbed (a sum's terms, a product's coefficient); an odd
+      // power of a negative-signed base, e.g. t^-1, stays the product (t^-1)·(−1), whose child
+      // is e itself: map e's children instead of recursing into e forever.
+      bool wraps = false;
+      if (sign < 0 && GiNaC::is_a<GiNaC::mul>(rep))
+        for (std::size_t i = 0; i < rep.nops(); ++i) wraps = wraps || rep.op(i).is_equal(e);
+      ex mapped = wraps ? ex(-map_children(e)) : map_children(rep);
       GiNaC::symbol tmp("c" + std::to_string(next++));
       order.set_sign(tmp, order.sign(mapped));
       out->push_back({tmp.get_name(), mapped, true, tmp});

@@ -223,6 +223,9 @@ Equations derive(const Model& model, const DeriveOptions& options) {
           eq.JR[3 * i + static_cast<std::size_t>(a)][j] += col.phi.w[a];
         }
       }
+  // Closed loops: the constraint stage, and the equations in the independent coordinates.
+  eq.loops = close_loops(model, eq);
+  reduce_equations(eq);
   return eq;
 }
 

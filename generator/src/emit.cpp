@@ -7,6 +7,7 @@
 #include "mbsgen/generator/escape.hpp"
 #include "mbsgen/generator/output_files.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -235,6 +236,12 @@ struct Kernel {
   std::vector<Argument> inputs;
   std::vector<Buffer> outputs;
   OperatingPointTest at_op = {};
+  /// A model with closed loops: the kernel is emitted as the internal `<name>_full` of all the
+  /// tree's coordinates, and `<name>` takes the independent ones and closes the loops first
+  /// (loop_kernels below).
+  bool wrapped = false;
+  /// Emitted as a static function (not declared in the header).
+  bool internal = false;
 };
 
 std::vector<ex> column_major(const ExMatrix& A, std::size_t rows, std::size_t cols) {
@@ -325,7 +332,7 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
   }
 
   std::ostringstream sig;
-  sig << "int " << id << "_" << k.name << "(";
+  sig << "int " << id << "_" << k.name << (k.wrapped ? "_full" : "") << "(";
   bool first = true;
   for (const auto& a : k.inputs) {
     sig << (first ? "" : ", ") << "const double* " << a.name;
@@ -339,7 +346,7 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
 
   std::ostringstream code;
   code << "// " << k.doc << "\n// operations: " << printer.operations << "\n";
-  code << "extern \"C\" " << sig.str() << " {\n";
+  code << (k.wrapped || k.internal ? "static " : "extern \"C\" ") << sig.str() << " {\n";
   for (const auto& a : k.inputs) code << "  (void)" << a.name << ";\n";
   code << body.str() << zeros_at_operating_point(k);
   code << "  int status = 0;\n";
@@ -349,6 +356,115 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
   code << "  return status;\n}\n\n";
   return {code.str(), {k.name, sig.str(), printer.operations}};
 }
+
+// The kernels of a model with closed loops (loop_closure.hpp), in all the tree's coordinates:
+// Φ(y), its Jacobian Φ_y (m×n) and the acceleration term γ(y, ẏ) of Φ_y ÿ + γ = 0, and the
+// operating point of every coordinate (internal: the start of `assemble`).
+std::vector<Kernel> loop_kernels(Equations& eq, const LinearEquations& lin) {
+  const LoopClosure& loops = eq.loops;
+  const std::size_t n = eq.y.size(), m = loops.equations.size();
+  std::vector<ex> y(eq.y.begin(), eq.y.end()), yd(eq.yd.begin(), eq.yd.end()), p(eq.p.begin(), eq.p.end());
+  std::vector<ex> phi, J;
+  for (const auto& e : loops.equations) phi.push_back(e.phi);
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t k = 0; k < m; ++k) J.push_back(loops.Phi_y[k][j]);
+  std::vector<Kernel> k;
+  k.push_back({"constraints", "constraint equations Phi(y): length m (zero on the motion)",
+               {{"y", y}, {"p", p}}, {{"phi", phi, ""}}});
+  k.push_back({"constraint_jacobian", "constraint Jacobian dPhi/dy: m×n, column-major",
+               {{"y", y}, {"p", p}}, {{"J", J, ""}}});
+  k.push_back({"constraint_bias", "gamma(y, yd): length m, with J(y) ydd + gamma = 0 on the motion",
+               {{"y", y}, {"yd", yd}, {"p", p}}, {{"gamma", loops.gamma, ""}}});
+  Kernel op{"operating_point_full", "the operating point of every tree coordinate",
+            {{"p", p}}, {{"y0", lin.y0, ""}, {"yd0", lin.yd0, ""}}};
+  op.internal = true;
+  k.push_back(op);
+  return k;
+}
+
+// `assemble`: the tree's coordinates from the independent ones, the dependent ones by Newton's
+// method on Φ(y) = 0 from the operating point. Status 2 when it fails (a singular Jacobian or
+// no convergence in 50 steps): the loops cannot be closed there.
+std::string assemble_code(const std::string& id, const Equations& eq) {
+  const LoopClosure& loops = eq.loops;
+  const std::size_t n = eq.y.size(), m = loops.equations.size(), f = loops.independent.size();
+  auto list = [](const std::vector<std::size_t>& v) {
+    std::string s;
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
+    return s;
+  };
+  std::string scales;
+  for (std::size_t k = 0; k < m; ++k) scales += (k ? ", " : "") + format_double(loops.equations[k].scale > 0 ? loops.equations[k].scale : 1.0);
+  std::ostringstream c;
+  c << "// Closes the loops: y (" << n << " tree coordinates) from yi (the " << f
+    << " independent ones); the dependent\n// ones by Newton's method on Phi(y) = 0, starting from the "
+       "operating point. Returns 0, 1 (not finite)\n// or 2 (the loops cannot be closed there: a singular "
+       "Jacobian, or no convergence).\n";
+  c << "extern \"C\" int " << id << "_assemble(const double* yi, const double* p, double* y) {\n";
+  c << "  static const int independent[" << f << "] = {" << list(loops.independent) << "};\n";
+  c << "  static const int dependent[" << m << "] = {" << list(loops.dependent) << "};\n";
+  c << "  static const double scale[" << m << "] = {" << scales << "};\n";
+  c << "  double yd0[" << n << "], phi[" << m << "], J[" << m * n << "], A[" << m * m << "], dx[" << m << "];\n";
+  c << "  if (" << id << "_operating_point_full(p, y, yd0) != 0) return 1;\n";
+  c << "  for (int i = 0; i < " << f << "; ++i) y[independent[i]] = yi[i];\n";
+  c << "  for (int iteration = 0; iteration < 50; ++iteration) {\n";
+  c << "    if (" << id << "_constraints(y, p, phi) != 0 || " << id << "_constraint_jacobian(y, p, J) != 0) return 1;\n";
+  c << "    // Near the solution the residual is rounding (about 1e-16 of each equation's size); one\n"
+       "    // more step from below 1e-13 then leaves y at full precision (Newton converges quadratically).\n";
+  c << "    bool small = true;\n";
+  c << "    for (int k = 0; k < " << m << "; ++k) small = small && std::fabs(phi[k]) <= 1e-13 * scale[k];\n";
+  c << "    for (int a = 0; a < " << m << "; ++a)\n      for (int b = 0; b < " << m << "; ++b) A[a + " << m
+    << " * b] = J[a + " << m << " * dependent[b]];\n";
+  c << "    if (!lu_solve(A, phi, dx, " << m << ")) return 2;\n";
+  c << "    for (int b = 0; b < " << m << "; ++b) y[dependent[b]] -= dx[b];\n";
+  c << "    if (!all_finite(y, " << n << ")) return 1;\n";
+  c << "    if (small) return 0;\n  }\n  return 2;\n}\n\n";
+  return c.str();
+}
+
+// The public form of a wrapped kernel: closes the loops, then calls `<name>_full`.
+std::string wrapper_code(const std::string& id, const Kernel& k, const std::string& signature, std::size_t n) {
+  std::ostringstream c;
+  c << "// " << k.doc << "\n// in the independent coordinates; the dependent ones are found by " << id
+    << "_assemble.\n";
+  c << "extern \"C\" " << signature << " {\n  double full[" << n << "];\n";
+  c << "  const int status = " << id << "_assemble(" << k.inputs[0].name << ", p, full);\n";
+  c << "  if (status != 0) return status;\n  return " << id << "_" << k.name << "_full(full";
+  for (std::size_t i = 1; i < k.inputs.size(); ++i) c << ", " << k.inputs[i].name;
+  for (const auto& b : k.outputs) c << ", " << b.name;
+  c << ");\n}\n\n";
+  return c.str();
+}
+
+// Dense LU with partial pivoting, for `assemble` (m is small: the number of loop equations).
+const char* const kLuSolve = R"(// Solves A x = b (A column-major n×n, overwritten) by LU with partial pivoting; false when A is
+// singular to working precision.
+bool lu_solve(double* A, const double* b, double* x, int n) {
+  double amax = 0;
+  for (int i = 0; i < n * n; ++i) amax = std::fmax(amax, std::fabs(A[i]));
+  for (int i = 0; i < n; ++i) x[i] = b[i];
+  for (int k = 0; k < n; ++k) {
+    int p = k;
+    for (int i = k + 1; i < n; ++i)
+      if (std::fabs(A[i + n * k]) > std::fabs(A[p + n * k])) p = i;
+    if (!(std::fabs(A[p + n * k]) > 1e-13 * amax)) return false;
+    if (p != k) {
+      for (int j = 0; j < n; ++j) std::swap(A[k + n * j], A[p + n * j]);
+      std::swap(x[k], x[p]);
+    }
+    for (int i = k + 1; i < n; ++i) {
+      const double l = A[i + n * k] / A[k + n * k];
+      for (int j = k + 1; j < n; ++j) A[i + n * j] -= l * A[k + n * j];
+      x[i] -= l * x[k];
+    }
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    for (int j = i + 1; j < n; ++j) x[i] -= A[i + n * j] * x[j];
+    x[i] /= A[i + n * i];
+  }
+  return true;
+}
+)";
 
 // The linear kernels' entries that are zero at the operating point only (column-major, as
 // the buffers), and the test of the arguments against the operating point y0(p), ẏ0(p).
@@ -378,6 +494,33 @@ void mark_zeros_at_operating_point(Kernel& k, const std::vector<const ZeroPatter
     }
 }
 
+// The manifest's "constraints": the tree's coordinates, which are independent (and whether
+// mbsgen chose them), the equations kept and those dropped, with why.
+std::string constraints_json(const Model& model, const LoopClosure& loops) {
+  auto names = [&](const std::vector<std::size_t>& v) {
+    std::string s;
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + json_string(model.coordinates()[v[i]].name);
+    return s;
+  };
+  auto equation = [](const ConstraintEquation& e) {
+    return "{\"constraint\": " + json_string(e.constraint) + ", \"component\": " + json_string(e.component);
+  };
+  std::ostringstream j;
+  std::vector<std::size_t> all(model.coordinates().size());
+  for (std::size_t k = 0; k < all.size(); ++k) all[k] = k;
+  j << "{\"tree_coordinates\": [" << names(all) << "], \"independent\": [" << names(loops.independent)
+    << "], \"dependent\": [" << names(loops.dependent) << "], \"independent_chosen_by\": "
+    << (loops.chosen ? "\"mbsgen (column-pivoted QR of the constraint Jacobian at the operating point)\""
+                     : "\"model\"")
+    << ", \"reactions_unique\": " << (loops.redundant ? "false" : "true") << ",\n    \"equations\": [";
+  for (std::size_t k = 0; k < loops.equations.size(); ++k) j << (k ? ", " : "") << equation(loops.equations[k]) << "}";
+  j << "],\n    \"dropped\": [";
+  for (std::size_t k = 0; k < loops.dropped.size(); ++k)
+    j << (k ? ",\n      " : "") << equation(loops.dropped[k].first) << ", \"reason\": " << json_string(loops.dropped[k].second) << "}";
+  j << "]}";
+  return j.str();
+}
+
 // The manifest's "sparsity": each linear matrix's rows as strings, 'x' an entry that may be
 // nonzero, '0' an exact zero, 'o' an exact zero at the operating point (general elsewhere); and
 // how many zeros were proved of each kind (structural_zeros.hpp).
@@ -402,26 +545,21 @@ std::string sparsity_json(const LinearEquations& lin) {
 
 }  // namespace
 
-GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin,
-                   const EmitOptions& options) {
-  GeneratedCode out;
-  SceneSelection scene = model.selection();
-  if (!options.scene.empty() && options.scene != scene.name)
-    throw std::invalid_argument("mbsgen::emit: the model was pruned for scene '" + scene.name +
-                                "', not '" + options.scene + "' (apply_scene)");
-  if (scene.full && scene.effects.empty()) scene.effects = effects_of(model);
-  if (!options.id.empty() && !id_problem(options.id).empty())
-    throw std::invalid_argument("mbsgen::emit: the id '" + options.id + "' " + id_problem(options.id));
-  // A model name that C++ cannot use as a name (int, std) gets a final '_'.
-  out.id = identifier(!options.id.empty() ? options.id
-                      : scene.full     ? model.name()
-                                       : model.name() + "_" + scene.name);
-  if (reserved_identifier(out.id)) out.id += "_";
-  const std::size_t f = eq.y.size(), m = eq.u.size(), r = eq.outputs.size();
+// The kernels of docs/generator.md, in emission order. With closed loops the coordinates y are
+// the tree's (n), the rates yd the independent ones, and the matrices those of the independent
+// coordinates (f); such kernels are wrapped (Kernel::wrapped).
+std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const LinearEquations& lin) {
+  const bool loops = eq.loops.active;
+  const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
   const std::size_t nb = model.bodies().size();
-  std::vector<ex> y(eq.y.begin(), eq.y.end()), yd(eq.yd.begin(), eq.yd.end()),
-      u(eq.u.begin(), eq.u.end()), p(eq.p.begin(), eq.p.end());
-
+  std::vector<ex> y(eq.y.begin(), eq.y.end()), yd, u(eq.u.begin(), eq.u.end()), p(eq.p.begin(), eq.p.end());
+  std::vector<ex> y0_out, yd0_out;
+  for (std::size_t k = 0; k < eq.yd.size(); ++k)
+    if (!loops || std::binary_search(eq.loops.independent.begin(), eq.loops.independent.end(), k)) {
+      yd.push_back(eq.yd[k]);
+      y0_out.push_back(lin.y0[k]);
+      yd0_out.push_back(lin.yd0[k]);
+    }
   std::vector<Kernel> kernels;
   kernels.push_back({"mass_matrix", "M(y, p): f×f mass matrix, column-major",
                      {{"y", y}, {"p", p}},
@@ -455,7 +593,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   kernels.push_back({"operating_point",
                      "operating point y0 (or the initial guess of an equilibrium) and steady rates yd0",
                      {{"p", p}},
-                     {{"y0", lin.y0, ""}, {"yd0", lin.yd0, ""}}});
+                     {{"y0", y0_out, ""}, {"yd0", yd0_out, ""}}});
   kernels.push_back({"outputs", "outputs z(y, yd): length r", {{"y", y}, {"yd", yd}, {"p", p}},
                      {{"z", eq.outputs, ""}}});
   std::vector<ex> rc, S, JT, JR, mass, Ic;
@@ -482,11 +620,51 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
                      {{"rc", rc, ""}, {"S", S, ""}, {"JT", JT, ""}, {"JR", JR, ""},
                       {"m", mass, ""}, {"Ic", Ic, ""}}});
 
+  if (loops)
+    for (auto& k : kernels) k.wrapped = k.name != "operating_point";
+  return kernels;
+}
+
+GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin,
+                   const EmitOptions& options) {
+  GeneratedCode out;
+  SceneSelection scene = model.selection();
+  if (!options.scene.empty() && options.scene != scene.name)
+    throw std::invalid_argument("mbsgen::emit: the model was pruned for scene '" + scene.name +
+                                "', not '" + options.scene + "' (apply_scene)");
+  if (scene.full && scene.effects.empty()) scene.effects = effects_of(model);
+  if (!options.id.empty() && !id_problem(options.id).empty())
+    throw std::invalid_argument("mbsgen::emit: the id '" + options.id + "' " + id_problem(options.id));
+  // A model name that C++ cannot use as a name (int, std) gets a final '_'.
+  out.id = identifier(!options.id.empty() ? options.id
+                      : scene.full     ? model.name()
+                                       : model.name() + "_" + scene.name);
+  if (reserved_identifier(out.id)) out.id += "_";
+  const bool loops = eq.loops.active;
+  const std::size_t f = lin.M.size(), n = eq.y.size(), m = eq.u.size(), r = eq.outputs.size();
+  const std::size_t nb = model.bodies().size();
+  std::vector<ex> p(eq.p.begin(), eq.p.end());
+  std::vector<Kernel> kernels = model_kernels(model, eq, lin);
   std::ostringstream kernel_code;
+  if (loops) {
+    kernel_code << "namespace {\n" << kLuSolve << "}  // namespace\n\n";
+    for (Kernel& k : loop_kernels(eq, lin)) {
+      EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse);
+      kernel_code << ek.code;
+      if (!k.internal) out.kernels.push_back(ek.info);
+    }
+    kernel_code << assemble_code(out.id, eq);
+    out.kernels.push_back({"assemble", "int " + out.id + "_assemble(const double* yi, const double* p, double* y)", 0});
+  }
   for (const auto& k : kernels) {
     if (!scene.emits(k.name)) continue;
     EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse);
     kernel_code << ek.code;
+    if (k.wrapped) {
+      const std::string full = "_" + k.name + "_full(";
+      ek.info.signature.replace(ek.info.signature.find(full), full.size(), "_" + k.name + "(");
+      kernel_code << wrapper_code(out.id, k, ek.info.signature, n);
+    }
     out.kernels.push_back(ek.info);
   }
 
@@ -527,7 +705,13 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   h << "extern const char* const " << out.id << "_parameter_names[];\n";
   h << "extern const double " << out.id << "_parameter_defaults[];\n";
   h << "extern const char* const " << out.id << "_input_names[];\n";
-  h << "extern const char* const " << out.id << "_output_names[];\n\n";
+  h << "extern const char* const " << out.id << "_output_names[];\n";
+  if (loops)
+    h << "// Closed loops: the kernels take the independent coordinates (coordinate_names); "
+         "assemble\n// and the constraint kernels all " << n << " tree coordinates.\nenum { " << out.id
+      << "_n_tree_coordinates = " << n << ", " << out.id << "_n_constraints = " << eq.loops.equations.size()
+      << " };\nextern const char* const " << out.id << "_tree_coordinate_names[];\n";
+  h << "\n";
   for (const auto& k : out.kernels) h << k.signature << ";\n";
   h << "\n#ifdef __cplusplus\n}\n#endif\n";
   out.header = h.str();
@@ -535,12 +719,15 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   auto names_array = [&](const std::string& what, const std::vector<std::string>& names) {
     std::ostringstream s;
     s << "extern \"C\" const char* const " << out.id << "_" << what << "[] = {";
-    for (const auto& n : names) s << cpp_string_literal(n) << ", ";
+    for (const auto& name : names) s << cpp_string_literal(name) << ", ";
     s << "nullptr};\n";
     return s.str();
   };
-  std::vector<std::string> cn, pn, in, on;
-  for (const auto& c : model.coordinates()) cn.push_back(c.name);
+  std::vector<std::string> cn, pn, in, on, tree;
+  for (const auto& c : model.coordinates()) tree.push_back(c.name);
+  for (std::size_t k = 0; k < n; ++k)
+    if (!loops || std::binary_search(eq.loops.independent.begin(), eq.loops.independent.end(), k))
+      cn.push_back(model.coordinates()[k].name);
   for (const auto& q : model.parameters()) pn.push_back(q.name);
   for (const auto& i : model.inputs()) in.push_back(i.name);
   for (const auto& o : model.outputs()) on.push_back(o.name);
@@ -552,6 +739,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   c << "extern \"C\" int " << out.id << "_abi_version(void) { return " << kAbiVersion << "; }\n";
   c << names_array("coordinate_names", cn) << names_array("parameter_names", pn)
     << names_array("input_names", in) << names_array("output_names", on);
+  if (loops) c << names_array("tree_coordinate_names", tree);
   c << "extern \"C\" const double " << out.id << "_parameter_defaults[] = {";
   for (const auto& q : model.parameters()) c << format_double(q.value) << ", ";
   c << "0.0};\n\n";
@@ -574,10 +762,13 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   else
     j << "null";
   j << ",\n  \"coordinates\": [";
-  for (std::size_t i = 0; i < f; ++i)
-    j << (i ? ", " : "") << "{\"name\": " << json_string(model.coordinates()[i].name)
-      << ", \"unit\": " << json_string(model.coordinates()[i].unit) << "}";
-  j << "],\n  \"parameters\": [";
+  for (std::size_t i = 0; i < f; ++i) {
+    const Coordinate& q = model.coordinates()[loops ? eq.loops.independent[i] : i];
+    j << (i ? ", " : "") << "{\"name\": " << json_string(q.name) << ", \"unit\": " << json_string(q.unit) << "}";
+  }
+  j << "]";
+  if (loops) j << ",\n  \"constraints\": " << constraints_json(model, eq.loops);
+  j << ",\n  \"parameters\": [";
   for (std::size_t i = 0; i < p.size(); ++i) {
     const auto& q = model.parameters()[i];
     j << (i ? ",\n    " : "\n    ") << "{\"name\": " << json_string(q.name)

@@ -80,8 +80,8 @@ Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operat
   // 1e-40 of the rest is not zero).
   GiNaC::exmap op_values;
   if (at_operating_point)
-    for (std::size_t k = 0; k < f; ++k) {
-      if (!lin.equilibrium) op_values[eq.y[k]] = lin.y0[k];
+    for (std::size_t k = 0; k < eq.y.size(); ++k) {
+      if (!lin.equilibrium && !eq.loops.active) op_values[eq.y[k]] = lin.y0[k];
       op_values[eq.yd[k]] = lin.yd0[k];
     }
   Program::Substitution op(op_values);
@@ -106,7 +106,8 @@ LinearEquations linearize(Equations& eq) {
   const Model& model = *eq.model;
   Program& prog = eq.program;
   LinearEquations lin;
-  const std::size_t f = eq.y.size(), m = eq.u.size(), r = eq.outputs.size();
+  std::size_t f = eq.y.size();
+  const std::size_t m = eq.u.size(), r = eq.outputs.size();
 
   const OperatingPoint& op = model.operating_point();
   lin.equilibrium = op.kind == OperatingPoint::Kind::equilibrium;
@@ -132,15 +133,19 @@ LinearEquations linearize(Equations& eq) {
   Program::Substitution sub(at_op);
   auto at = [&](const ex& e) { return prog.substitute(e, sub); };
 
+  // With closed loops the tree is linearized first, then reduced (loop_closure.hpp).
+  const bool loops = eq.loops.active;
+  const std::vector<ex>& residual = loops ? eq.tree.residual : eq.residual;
+  const std::vector<ex>& outputs = loops ? eq.tree.outputs : eq.outputs;
   std::vector<ex> residual_at_rest(f);
-  for (std::size_t i = 0; i < f; ++i) residual_at_rest[i] = prog.define(at(eq.residual[i]));
+  for (std::size_t i = 0; i < f; ++i) residual_at_rest[i] = prog.define(at(residual[i]));
 
-  lin.M = eq.M;
+  lin.M = loops ? eq.tree.M : eq.M;
   lin.Q.assign(f, std::vector<ex>(f, 0));
   lin.K.assign(f, std::vector<ex>(f, 0));
   lin.B.assign(f, std::vector<ex>(m, 0));
   for (std::size_t i = 0; i < f; ++i) {
-    ex ri = prog.define(eq.residual[i]);
+    ex ri = prog.define(residual[i]);
     for (std::size_t j = 0; j < f; ++j) {
       lin.Q[i][j] = at(prog.diff(ri, eq.yd[j]));
       // ∂/∂y commutes with setting ẏ = 0 and u = 0, which are independent of y.
@@ -151,11 +156,15 @@ LinearEquations linearize(Equations& eq) {
   lin.Cy.assign(r, std::vector<ex>(f, 0));
   lin.Cv.assign(r, std::vector<ex>(f, 0));
   for (std::size_t i = 0; i < r; ++i) {
-    ex zi = prog.define(eq.outputs[i]);
+    ex zi = prog.define(outputs[i]);
     for (std::size_t j = 0; j < f; ++j) {
       lin.Cy[i][j] = at(prog.diff(zi, eq.y[j]));
       lin.Cv[i][j] = at(prog.diff(zi, eq.yd[j]));
     }
+  }
+  if (loops) {
+    reduce_linear(eq, residual_at_rest, lin.M, lin.Q, lin.K, lin.B, lin.Cy, lin.Cv);
+    f = eq.loops.independent.size();
   }
   auto split = [&](const ExMatrix& A, ExMatrix& S, ExMatrix& W) {
     S.assign(f, std::vector<ex>(f, 0));

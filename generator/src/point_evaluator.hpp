@@ -102,7 +102,8 @@ class PointEvaluator {
 /// structural_zeros.cpp): every coordinate, rate, input and parameter uniform in [0.5, 2.5)
 /// (exact rationals from the xorshift64 sequence in `state`, advanced); with at_operating_point,
 /// the rates, and for a `given` operating point the coordinates, at the operating point of those
-/// parameters (an equilibrium's coordinates stay free: they are known only numerically).
+/// parameters (an equilibrium's coordinates stay free: they are known only numerically; so do
+/// those of a model with closed loops, whose dependent coordinates the kernels refine).
 inline GiNaC::exmap sample_point(const Equations& eq, const LinearEquations& lin, std::uint64_t& state,
                                  bool at_operating_point) {
   GiNaC::exmap values;
@@ -115,7 +116,7 @@ inline GiNaC::exmap sample_point(const Equations& eq, const LinearEquations& lin
     GiNaC::exmap p;
     for (const auto& x : eq.p) p[x] = values[x];
     for (std::size_t k = 0; k < eq.y.size(); ++k) {
-      if (!lin.equilibrium) values[eq.y[k]] = GiNaC::evalf(lin.y0[k].subs(p, GiNaC::subs_options::no_pattern));
+      if (!lin.equilibrium && !eq.loops.active) values[eq.y[k]] = GiNaC::evalf(lin.y0[k].subs(p, GiNaC::subs_options::no_pattern));
       values[eq.yd[k]] = GiNaC::evalf(lin.yd0[k].subs(p, GiNaC::subs_options::no_pattern));
     }
   }

@@ -164,7 +164,9 @@ StructuralZeros find_structural_zeros(Equations& eq, LinearEquations& lin) {
       (*t.pattern)[i].assign((*t.matrix)[i].size(), EntryZero::nonzero);
   }
   const std::vector<ZeroPattern> everywhere = screen(eq, lin, z, false);
-  const bool given = !lin.equilibrium;
+  // A model with closed loops has its dependent coordinates refined by the kernels (Newton),
+  // not equal to the given expressions bit for bit: no zeros at the operating point only.
+  const bool given = !lin.equilibrium && !eq.loops.active;
   const std::vector<ZeroPattern> at_op =
       given ? screen(eq, lin, z, true) : std::vector<ZeroPattern>(ts.size());
 

@@ -10,13 +10,11 @@
 // stiffness matrix of a conservative element exactly symmetric.
 #pragma once
 
-#include "mbsgen/generator/kinematics.hpp"
+#include "mbsgen/generator/loop_closure.hpp"
 
 #include <vector>
 
 namespace mbsgen {
-
-using ExMatrix = std::vector<std::vector<GiNaC::ex>>;
 
 /// The derived equations; every expression refers to intermediates of `program`.
 struct Equations {
@@ -28,6 +26,14 @@ struct Equations {
   std::vector<GiNaC::ex> residual;          ///< k(y, ẏ) − q(y, ẏ, u), length f
   std::vector<GiNaC::ex> outputs;           ///< z(y, ẏ), one per model output
   ExMatrix JT, JR;                          ///< per body 3×f: centre-of-mass and angular Jacobians
+  /// Closed loops (loop_closure.hpp). When active, M, residual, outputs, JT and JR above are
+  /// those of the independent coordinates (f = n − m columns; the residual and outputs take the
+  /// rates of the independent coordinates), and `tree` keeps the tree's (n columns).
+  LoopClosure loops;
+  struct Tree {
+    ExMatrix M, JT, JR;
+    std::vector<GiNaC::ex> residual, outputs;
+  } tree;
 };
 
 /// How derive() projects the Newton–Euler equations of the bodies onto the coordinates.

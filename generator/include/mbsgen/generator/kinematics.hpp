@@ -17,6 +17,8 @@
 
 namespace mbsgen {
 
+using ExMatrix = std::vector<std::vector<GiNaC::ex>>;
+
 /// A spatial motion (ω, v) or force (n, f) vector in the world frame, about the world origin.
 struct Spatial {
   Vec3 w = zero_vec3();
