@@ -157,22 +157,25 @@ Eigen::Index rank_of(const MatrixXd& J) {
   return qr.rank();
 }
 
-// The equations (rows of J) involved in a dependency, and the coordinates they involve.
-std::string dependency(const Model& model, const std::vector<RawEquation>& raw, const MatrixXd& J) {
+// The equations (rows of J) involved in a dependency (a left null vector of J), and the
+// coordinates they depend on.
+std::string dependency(const Model& model, Equations& eq, const std::vector<RawEquation>& raw, const MatrixXd& J) {
   Eigen::FullPivLU<MatrixXd> lu(J.transpose());
   lu.setThreshold(kRankTolerance);
   const MatrixXd W = lu.kernel();
-  const double wmax = W.cwiseAbs().maxCoeff(), jmax = J.cwiseAbs().maxCoeff();
+  const double wmax = W.cwiseAbs().maxCoeff();
   std::string eqs, coords;
-  std::set<Eigen::Index> columns;
+  std::set<std::size_t> columns;
   for (Eigen::Index k = 0; k < J.rows(); ++k) {
     if (W.row(k).cwiseAbs().maxCoeff() <= 1e-8 * wmax) continue;
-    eqs += (eqs.empty() ? "" : ", ") + describe(raw[static_cast<std::size_t>(k)].equation);
-    for (Eigen::Index j = 0; j < J.cols(); ++j)
-      if (std::abs(J(k, j)) > 1e-12 * jmax) columns.insert(j);
+    const ConstraintEquation& e = raw[static_cast<std::size_t>(k)].equation;
+    eqs += (eqs.empty() ? "" : ", ") + describe(e);
+    for (std::size_t j = 0; j < eq.y.size(); ++j)
+      if (eq.program.depends_on(e.phi, eq.y[j])) columns.insert(j);
   }
-  for (Eigen::Index j : columns) coords += (coords.empty() ? "" : ", ") + model.coordinates()[static_cast<std::size_t>(j)].name;
-  return "the equations " + eqs + " (in the coordinates " + coords + ")";
+  for (std::size_t j : columns) coords += (coords.empty() ? "" : ", ") + model.coordinates()[j].name;
+  return "the gradients of the equations " + eqs + " (in the coordinates " + coords +
+         ") are linearly dependent (or zero)";
 }
 
 // Drops equations that are redundant for every configuration (the rank is deficient at a
@@ -186,12 +189,12 @@ void drop_redundant(const Model& model, Equations& eq, std::vector<RawEquation>&
   LinearEquations none;
   GiNaC::exmap random = detail::sample_point(eq, none, state, false);
   const Numbers elsewhere = evaluate(eq, raw, Phi_y, random);
-  const std::string what = dependency(model, raw, at_op.J);
+  const std::string what = dependency(model, eq, raw, at_op.J);
   const Constraint& first = constraint_named(model, raw.front().equation.constraint);
   if (rank_of(elsewhere.J) > rank)
     throw ModelError(model.operating_point().where.line ? model.operating_point().where : first.where,
                      "the constraint Jacobian is singular at the operating point: " + what +
-                         " are dependent there. This is a singular position (a dead point or a locked "
+                         " there. This is a singular position (a dead point or a locked "
                          "mechanism), or constraints redundant on the motion; the dependent coordinates "
                          "cannot be found from independent ones there, and the reaction forces would not "
                          "be unique");
@@ -207,8 +210,8 @@ void drop_redundant(const Model& model, Equations& eq, std::vector<RawEquation>&
       kept.push_back(raw[k]);
       kept_J.push_back(Phi_y[k]);
     } else {
-      loops.dropped.push_back({raw[k].equation, "redundant: dependent on the other equations in every "
-                                                "configuration (" + what + "); the reaction forces are not unique"});
+      loops.dropped.push_back({raw[k].equation, "redundant in every configuration (" + what +
+                                                    "); the reaction forces are not unique"});
     }
   }
   loops.redundant = true;

@@ -27,6 +27,13 @@ Eigen::Index find(const std::vector<std::string>& list, const std::string& name,
 }
 
 void check_status(int status, const char* kernel, const std::string& model) {
+  // Status 2: a model with closed loops whose dependent coordinates could not be found
+  // (docs/generated-abi.md): Newton's method on the constraints failed from the operating point.
+  if (status == 2)
+    throw Error(std::string("kernel ") + kernel + " of model '" + model +
+                "' could not close the kinematic loops there: the constraints have no solution near the "
+                "operating point for these coordinates and parameters, or their Jacobian is singular (a dead "
+                "point)");
   if (status != 0)
     throw NonFiniteError(std::string("kernel ") + kernel + " of model '" + model +
                          "' returned a non-finite value (check the parameters)");
