@@ -1,5 +1,6 @@
 #include "mbsgen/generator/chain.hpp"
 
+#include <cmath>
 #include <string>
 
 namespace mbsgen {
@@ -94,6 +95,110 @@ Model spatial_chain(int n) {
     model.add_generalized_force({"damper_" + q.name, q.name, -c * q.velocity, {}, Category::dampers});
   }
   add_chain_scenes(model);
+  return model;
+}
+
+}  // namespace mbsgen
+
+namespace mbsgen {
+
+namespace {
+
+// A uniform slender bar along its body x axis, rotated about z by `angle` relative to `parent`.
+void add_bar(Model& model, const std::string& name, const std::string& parent, const Vec3& translation,
+             const GiNaC::ex& angle, const GiNaC::ex& mass, const GiNaC::ex& length) {
+  Body b;
+  b.name = name;
+  b.parent = parent;
+  b.translation = translation;
+  b.rotations = {{Axis::z, angle}};
+  b.mass = mass;
+  b.com = {length / 2, GiNaC::ex(0), GiNaC::ex(0)};
+  b.inertia[1][1] = b.inertia[2][2] = mass * length * length / 12;
+  model.add_body(b);
+}
+
+void add_marker(Model& model, const std::string& name, const std::string& body, const Vec3& position) {
+  Marker m;
+  m.name = name;
+  m.body = body;
+  m.position = position;
+  model.add_marker(m);
+}
+
+void add_revolute(Model& model, const std::string& name, const std::string& a, const std::string& b) {
+  Constraint c;
+  c.name = name;
+  c.kind = ConstraintKind::revolute;
+  c.marker_a = a;
+  c.marker_b = b;
+  model.add_constraint(c);
+}
+
+}  // namespace
+
+Model four_bar_linkage() {
+  Model model("four_bar_linkage");
+  const double a = 0.4, l1 = 0.1, l2 = 0.35, l3 = 0.25, theta1 = 1.0;
+  const GiNaC::ex g = model.add_parameter("g", 9.81, "m/s^2"), A = model.add_parameter("a", a, "m"),
+                  L1 = model.add_parameter("l1", l1, "m"), L2 = model.add_parameter("l2", l2, "m"),
+                  L3 = model.add_parameter("l3", l3, "m"), m = model.add_parameter("m", 0.3, "kg"),
+                  k = model.add_parameter("k", 40.0, "N/m"), L0 = model.add_parameter("L0", 0.1, "m");
+  const GiNaC::ex t1 = model.add_coordinate("th1", "rad").position, t2 = model.add_coordinate("th2", "rad").position,
+                  t3 = model.add_coordinate("th3", "rad").position;
+  add_bar(model, "crank", kWorld, zero_vec3(), t1, m, L1);
+  add_bar(model, "coupler", "crank", {L1, GiNaC::ex(0), GiNaC::ex(0)}, t2, m, L2);
+  add_bar(model, "rocker", kWorld, {A, GiNaC::ex(0), GiNaC::ex(0)}, t3, m, L3);
+  add_marker(model, "coupler_end", "coupler", {L2, GiNaC::ex(0), GiNaC::ex(0)});
+  add_marker(model, "rocker_tip", "rocker", {L3, GiNaC::ex(0), GiNaC::ex(0)});
+  add_marker(model, "coupler_middle", "coupler", {L2 / 2, GiNaC::ex(0), GiNaC::ex(0)});
+  add_marker(model, "anchor", kWorld, {A / 2, GiNaC::ex(0.5), GiNaC::ex(0)});
+  model.add_gravity({"gravity", {GiNaC::ex(0), -g, GiNaC::ex(0)}, {}});
+  model.add_spring({"spring", "anchor", "coupler_middle", k, L0, {}});
+  add_revolute(model, "pin", "coupler_end", "rocker_tip");
+  // Initial guess of the equilibrium: the loop closed at crank angle theta1 (the intersection
+  // of the circles about the crank's tip and the rocker's pivot, elbow up).
+  const double Ax = l1 * std::cos(theta1), Ay = l1 * std::sin(theta1);
+  const double dx = a - Ax, dy = -Ay, d = std::hypot(dx, dy);
+  const double along = (l2 * l2 - l3 * l3 + d * d) / (2 * d), h = std::sqrt(l2 * l2 - along * along);
+  const double Bx = Ax + (along * dx - h * dy) / d, By = Ay + (along * dy + h * dx) / d;
+  OperatingPoint op;
+  op.kind = OperatingPoint::Kind::equilibrium;
+  op.position = {{"th1", theta1},
+                 {"th2", std::atan2(By - Ay, Bx - Ax) - theta1},
+                 {"th3", std::atan2(By, Bx - a)}};
+  model.set_operating_point(op);
+  return model;
+}
+
+Model ladder(int n) {
+  Model model("ladder_" + std::to_string(n));
+  const GiNaC::ex g = model.add_parameter("g", 9.81, "m/s^2"), h = model.add_parameter("h", 0.2, "m"),
+                  w = model.add_parameter("w", 0.3, "m"), m = model.add_parameter("m", 0.2, "kg"),
+                  k = model.add_parameter("k", 2.0, "N m/rad");
+  OperatingPoint op;
+  for (int i = 1; i <= n; ++i) {
+    const std::string s = std::to_string(i);
+    for (const char* side : {"a", "b"}) {
+      const GiNaC::ex q = model.add_coordinate(std::string(side) + s, "rad").position;
+      const std::string parent = i == 1 ? std::string(kWorld) : std::string(side) + std::to_string(i - 1);
+      const Vec3 at = i == 1 ? Vec3{std::string(side) == "a" ? GiNaC::ex(0) : w, GiNaC::ex(0), GiNaC::ex(0)}
+                             : Vec3{h, GiNaC::ex(0), GiNaC::ex(0)};
+      add_bar(model, std::string(side) + s, parent, at, q, m, h);
+      add_marker(model, std::string(side) + s + "_tip", std::string(side) + s, {h, GiNaC::ex(0), GiNaC::ex(0)});
+      const GiNaC::ex hanging = i == 1 ? -GiNaC::Pi / 2 : GiNaC::ex(0);
+      model.add_generalized_force({std::string("spring_") + side + s, std::string(side) + s,
+                                   -k * (q - hanging), {}, Category::springs});
+      op.position[std::string(side) + s] = hanging;
+    }
+    const GiNaC::ex r = model.add_coordinate("r" + s, "rad").position;
+    add_bar(model, "rung" + s, "a" + s, {h, GiNaC::ex(0), GiNaC::ex(0)}, r, m, w);
+    add_marker(model, "rung" + s + "_end", "rung" + s, {w, GiNaC::ex(0), GiNaC::ex(0)});
+    add_revolute(model, "pin" + s, "rung" + s + "_end", "b" + s + "_tip");
+    op.position["r" + s] = GiNaC::Pi / 2;
+  }
+  model.add_gravity({"gravity", {GiNaC::ex(0), -g, GiNaC::ex(0)}, {}});
+  model.set_operating_point(op);
   return model;
 }
 

@@ -1,6 +1,6 @@
 // Writes the generated kernels of a model built through the C++ API (chain.hpp), for its full
 // model or one of its scenes:
-//   gen_api_models planar|spatial N ID OUT_DIR [SCENE]
+//   gen_api_models planar|spatial|four_bar|ladder N ID OUT_DIR [SCENE]
 #include "mbsgen/generator/chain.hpp"
 #include "mbsgen/generator/emit.hpp"
 #include "mbsgen/generator/scene.hpp"
@@ -10,12 +10,15 @@
 
 int main(int argc, char** argv) {
   if (argc != 5 && argc != 6) {
-    std::cerr << "usage: gen_api_models planar|spatial N ID OUT_DIR [SCENE]\n";
+    std::cerr << "usage: gen_api_models planar|spatial|four_bar|ladder N ID OUT_DIR [SCENE]\n";
     return 2;
   }
   const std::string kind = argv[1];
   const int n = std::stoi(argv[2]);
-  const mbsgen::Model chain = kind == "planar" ? mbsgen::planar_chain(n) : mbsgen::spatial_chain(n);
+  const mbsgen::Model chain = kind == "planar"     ? mbsgen::planar_chain(n)
+                              : kind == "four_bar" ? mbsgen::four_bar_linkage()
+                              : kind == "ladder"   ? mbsgen::ladder(n)
+                                                   : mbsgen::spatial_chain(n);
   const mbsgen::Model model = mbsgen::apply_scene(chain, argc == 6 ? argv[5] : mbsgen::kFullScene);
   mbsgen::Equations eq = mbsgen::derive(model);
   mbsgen::LinearEquations lin = mbsgen::linearize(eq);

@@ -29,6 +29,7 @@ struct GeneratedModel {
   int (*outputs)(const double* y, const double* yd, const double* p, double* z);
   int (*bodies)(const double* y, const double* p, double* rc, double* S, double* JT, double* JR,
                 double* m, double* Ic);
+  bool equilibrium = false;  ///< operating_point gives an equilibrium's initial guess
 };
 
 /// The kernels of one scene (a model pruned by apply_scene): a kernel the scene does not emit
@@ -69,7 +70,7 @@ inline std::vector<std::complex<double>> quadratic_eigenvalues(const Eigen::Matr
         id##_n_bodies, id##_at_rest != 0, id##_parameter_defaults, id##_coordinate_names,   \
         id##_parameter_names, id##_input_names, id##_output_names, id##_mass_matrix,        \
         id##_residual, id##_linear, id##_linear_structured, id##_operating_point,           \
-        id##_outputs, id##_bodies                                                           \
+        id##_outputs, id##_bodies, id##_equilibrium != 0                                    \
   }
 
 #define MBSGEN_GENERATED_SCENE(id)                                                          \

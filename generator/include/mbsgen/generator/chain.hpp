@@ -19,4 +19,18 @@ Model planar_chain(int n);
 /// scenes as planar_chain.
 Model spatial_chain(int n);
 
+/// A four-bar in the x–y plane (ground a = 0.4 m, crank l1 = 0.1 m, coupler l2 = 0.35 m, rocker
+/// l3 = 0.25 m, uniform bars of 0.3 kg): crank (th1) and rocker (th3) pivoted on the world, the
+/// coupler (th2, relative to the crank) joined to the rocker's tip by the revolute constraint
+/// `pin`; gravity −y and a spring from a world anchor to the coupler's middle load the loop.
+/// Operating point: the equilibrium near th1 = 1 rad (guess closed elbow up).
+Model four_bar_linkage();
+
+/// A planar ladder of N closed loops hanging under gravity: two rails of N bars (a_i, b_i, length
+/// h, relative angles, a joint spring on each, relaxed when hanging) from pivots w apart, and N rungs (r_i, length w)
+/// each a child of rail a's i-th bar and joined to rail b's i-th bar by a revolute constraint.
+/// 3N coordinates, 2N constraint equations, N degrees of freedom; given operating point hanging
+/// straight (exact).
+Model ladder(int n);
+
 }  // namespace mbsgen
