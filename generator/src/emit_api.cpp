@@ -61,7 +61,7 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
   const std::string& id = code.id;
   std::vector<std::string> pn, cn, in, on;
   for (const auto& p : model.parameters()) pn.push_back(p.name);
-  for (const auto& c : model.coordinates()) cn.push_back(c.name);
+  for (std::size_t k : lin.coordinates) cn.push_back(model.coordinates()[k].name);
   for (const auto& i : model.inputs()) in.push_back(i.name);
   for (const auto& o : model.outputs()) on.push_back(o.name);
   const auto pm = members(pn), cm = members(cn), im = members(in), om = members(on);
@@ -116,7 +116,7 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     return o;
   };
   std::vector<std::string> cu, pu, iu, ou, defaults;
-  for (const auto& c : model.coordinates()) cu.push_back(c.unit);
+  for (std::size_t k : lin.coordinates) cu.push_back(model.coordinates()[k].unit);
   for (const auto& p : model.parameters()) {
     pu.push_back(p.unit);
     defaults.push_back(format_double(p.value));

@@ -162,9 +162,11 @@ LinearEquations linearize(Equations& eq) {
       lin.Cv[i][j] = at(prog.diff(zi, eq.yd[j]));
     }
   }
+  for (std::size_t k = 0; k < f; ++k) lin.coordinates.push_back(k);
   if (loops) {
     reduce_linear(eq, residual_at_rest, lin.M, lin.Q, lin.K, lin.B, lin.Cy, lin.Cv);
     f = eq.loops.independent.size();
+    lin.coordinates = eq.loops.independent;
   }
   auto split = [&](const ExMatrix& A, ExMatrix& S, ExMatrix& W) {
     S.assign(f, std::vector<ex>(f, 0));

@@ -26,8 +26,31 @@ int linear_main(int argc, char** argv);
 namespace {
 
 // `model` is the scene's pruned model; `scenes` the scenes of the model file.
+// Closed loops: the constraint equations kept and dropped, and the independent coordinates.
+void print_loops(const mbsgen::Model& model, const mbsgen::LoopClosure& loops) {
+  if (!loops.active) return;
+  auto names = [&](const std::vector<std::size_t>& v) {
+    std::string s;
+    for (std::size_t k : v) s += " " + model.coordinates()[k].name;
+    return s;
+  };
+  std::cout << "closed loops: " << loops.equations.size() << " constraint equations in "
+            << model.coordinates().size() << " coordinates\n";
+  std::cout << "  independent coordinates (" << (loops.chosen ? "chosen by mbsgen: column-pivoted QR of the "
+                                                              "constraint Jacobian at the operating point"
+                                                            : "listed in the model")
+            << "):" << names(loops.independent) << "\n  dependent coordinates:" << names(loops.dependent) << "\n";
+  std::cout << "  equations:";
+  for (const auto& e : loops.equations) std::cout << " " << e.constraint << (e.component.empty() ? "" : "." + e.component);
+  std::cout << "\n";
+  for (const auto& [e, why] : loops.dropped)
+    std::cout << "  dropped " << e.constraint << (e.component.empty() ? "" : "." + e.component) << ": " << why << "\n";
+  if (loops.redundant) std::cout << "  the reaction forces are not unique (redundant constraints)\n";
+}
+
 int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& scenes,
-               const mbsgen::LinearEquations& lin, const mbsgen::GeneratedCode& code, double seconds) {
+               const mbsgen::Equations& eq, const mbsgen::LinearEquations& lin, const mbsgen::GeneratedCode& code,
+               double seconds) {
   const mbsgen::SceneSelection& scene = model.selection();
   std::cout << "model " << model.name() << "\n";
   std::cout << "scenes: full (implicit)";
@@ -47,7 +70,9 @@ int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& sce
   for (const auto& b : model.bodies()) std::cout << " " << b.name << "<-" << b.parent;
   std::cout << "\ncoordinates (" << model.coordinates().size() << "):";
   for (const auto& c : model.coordinates()) std::cout << " " << c.name;
-  std::cout << "\ninputs (" << model.inputs().size() << "):";
+  std::cout << "\n";
+  print_loops(model, eq.loops);
+  std::cout << "inputs (" << model.inputs().size() << "):";
   for (const auto& i : model.inputs()) std::cout << " " << i.name;
   std::cout << "\noutputs (" << model.outputs().size() << "):";
   for (const auto& o : model.outputs()) std::cout << " " << o.name;
@@ -164,7 +189,7 @@ int main(int argc, char** argv) try {
     mbsgen::GeneratedCode code = mbsgen::emit(pruned, eq, lin, options);
     progress.stop();
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (*info) return print_info(pruned, model.scenes(), lin, code, seconds);
+    if (*info) return print_info(pruned, model.scenes(), eq, lin, code, seconds);
     const auto& range = pruned.selection().frequency_range;
     mbsgen::write_generated(code,
                             mbsgen::emit_api(pruned, lin, code, scene, range ? range->from_hz : 0.0,

@@ -18,6 +18,9 @@ struct LinearEquations {
   /// and in a scene every rate its operating point sets to zero; the kernels ignore these
   /// components of ẏ0.
   std::vector<std::size_t> zero_rates;
+  /// The model's coordinates (indices) that the linear model and the kernels use: all of them,
+  /// or the independent ones of a model with closed loops (loop_closure.hpp).
+  std::vector<std::size_t> coordinates;
   ExMatrix M, Q, K, B, Cy, Cv;  ///< f×f, f×f, f×f, f×m, r×f, r×f (expressions in y, ẏ, p)
   ExMatrix D, G, Ks, N;         ///< sym Q, skew Q, sym K, skew K
   std::vector<GiNaC::ex> y0, yd0;  ///< default operating point (expressions in p)
