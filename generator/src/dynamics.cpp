@@ -1,5 +1,7 @@
 #include "mbsgen/generator/dynamics.hpp"
 
+#include "mbsgen/generator/reactions.hpp"
+
 #include <algorithm>
 #include <utility>
 
@@ -15,16 +17,27 @@ Spatial wrench_at_origin(const Vec3& point, const Vec3& force, const Vec3& torqu
 
 }  // namespace
 
-Equations derive(const Model& model, const DeriveOptions& options) {
-  model.validate();
+namespace {
+
+bool has_reactions(const Model& model) {
+  for (const auto& o : model.outputs())
+    if (o.kind == OutputKind::reaction) return true;
+  return false;
+}
+
+// The tree's equations of `model` (which may carry joint probes, reactions.hpp); `accelerations`
+// are the symbols ÿ of `original`'s coordinates, registered when outputs need them.
+Equations derive_tree(const Model& model, const Model& original, const DeriveOptions& options) {
   Equations eq;
   eq.model = &model;
   for (const auto& c : model.coordinates()) eq.y.push_back(c.position);
   for (const auto& c : model.coordinates()) eq.yd.push_back(c.velocity);
   eq.u = model.input_symbols();
   for (const auto& p : model.parameters()) eq.p.push_back(p.symbol);
+  if (has_reactions(original))
+    for (const auto& c : original.coordinates()) eq.ydd.push_back(GiNaC::symbol(c.name + "_ddot"));
   Program& prog = eq.program;
-  for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p})
+  for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p, &eq.ydd})
     for (const auto& s : *group) prog.add_variable(s);
 
   eq.kinematics = compute_kinematics(model, prog);
@@ -206,6 +219,9 @@ Equations derive(const Model& model, const DeriveOptions& options) {
         break;
       case OutputKind::force:  // element forces: being built (issue 15)
         throw ModelError(o.where, "output '" + o.name + "': force outputs are not derived yet");
+      case OutputKind::reaction:  // reaction_outputs (reactions.hpp) writes it
+        eq.outputs.push_back(0);
+        break;
     }
   }
 
@@ -223,8 +239,24 @@ Equations derive(const Model& model, const DeriveOptions& options) {
           eq.JR[3 * i + static_cast<std::size_t>(a)][j] += col.phi.w[a];
         }
       }
-  // Closed loops: the constraint stage, and the equations in the independent coordinates.
+  return eq;
+}
+
+}  // namespace
+
+Equations derive(const Model& model, const DeriveOptions& options) {
+  model.validate();
+  // Joint loads: the tree with probes in the asked joints, then the probes removed (reactions.hpp).
+  JointProbes probes;
+  probes.bodies = probed_bodies(model);
+  const Model probed = probes.bodies.empty() ? Model(model.name()) : with_joint_probes(model, probes.bodies);
+  Equations eq = derive_tree(probes.bodies.empty() ? model : probed, model, options);
+  if (!probes.bodies.empty()) strip_joint_probes(model, eq, probes);
+  eq.model = &model;
+  // Closed loops: the constraint stage, the reactions, and the equations in the independent
+  // coordinates.
   eq.loops = close_loops(model, eq);
+  if (has_reactions(model)) reaction_outputs(eq, probes);
   reduce_equations(eq);
   return eq;
 }

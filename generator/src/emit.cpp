@@ -594,8 +594,30 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
                      "operating point y0 (or the initial guess of an equilibrium) and steady rates yd0",
                      {{"p", p}},
                      {{"y0", y0_out, ""}, {"yd0", yd0_out, ""}}});
-  kernels.push_back({"outputs", "outputs z(y, yd): length r", {{"y", y}, {"yd", yd}, {"p", p}},
-                     {{"z", eq.outputs, ""}}});
+  // Outputs that depend on accelerations and inputs (reactions.hpp): `outputs` gives them at
+  // ydd = 0 and u = 0 (static loads), `outputs_general` at any (y, yd, ydd, u), and `output_terms`
+  // the linear rows C_a and D of the frequency response.
+  std::vector<ex> z = eq.outputs, ydd;
+  if (!eq.ydd.empty()) {
+    GiNaC::exmap rest;
+    for (const auto& s : eq.u) rest[s] = 0;
+    for (const auto& s : eq.ydd) rest[s] = 0;
+    Program::Substitution at_rest(rest);
+    for (auto& x : z) x = eq.program.substitute(x, at_rest);
+    for (std::size_t k = 0; k < eq.ydd.size(); ++k)
+      if (!loops || std::binary_search(eq.loops.independent.begin(), eq.loops.independent.end(), k))
+        ydd.push_back(eq.ydd[k]);
+  }
+  kernels.push_back({"outputs", "outputs z(y, yd) (at ydd = 0, u = 0): length r", {{"y", y}, {"yd", yd}, {"p", p}},
+                     {{"z", z, ""}}});
+  if (!eq.ydd.empty())
+    kernels.push_back({"outputs_general", "outputs z(y, yd, ydd, u): length r (reaction forces need ydd and u)",
+                       {{"y", y}, {"yd", yd}, {"ydd", ydd}, {"u", u}, {"p", p}},
+                       {{"z", eq.outputs, ""}}});
+  if (!lin.Ca.empty())
+    kernels.push_back({"output_terms", "output rows C_a (r×f) and D (r×m) of z = C_y y + C_v yd + C_a ydd + D u, column-major",
+                       {{"y0", y}, {"yd0", lin.at_rest ? std::vector<ex>{} : yd}, {"p", p}},
+                       {{"Ca", column_major(lin.Ca, r, f), ""}, {"D", column_major(lin.Du, r, m), ""}}});
   std::vector<ex> rc, S, JT, JR, mass, Ic;
   for (std::size_t i = 0; i < nb; ++i) {
     const BodyKinematics& b = eq.kinematics.bodies[i];
@@ -657,7 +679,8 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
     out.kernels.push_back({"assemble", "int " + out.id + "_assemble(const double* yi, const double* p, double* y)", 0});
   }
   for (const auto& k : kernels) {
-    if (!scene.emits(k.name)) continue;
+    const std::string as = k.name == "outputs_general" ? "outputs" : k.name == "output_terms" ? "linear" : k.name;
+    if (!scene.emits(as)) continue;
     EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse);
     kernel_code << ek.code;
     if (k.wrapped) {

@@ -125,6 +125,7 @@ LinearEquations linearize(Equations& eq) {
   // rates), so that only the nonzero rates remain arguments of the kernels.
   GiNaC::exmap at_op;
   for (const auto& s : eq.u) at_op[s] = 0;
+  for (const auto& s : eq.ydd) at_op[s] = 0;
   for (std::size_t k = 0; k < f; ++k)
     if (lin.at_rest || (!model.selection().full && lin.yd0[k].is_zero())) {
       at_op[eq.yd[k]] = 0;
@@ -155,16 +156,21 @@ LinearEquations linearize(Equations& eq) {
   }
   lin.Cy.assign(r, std::vector<ex>(f, 0));
   lin.Cv.assign(r, std::vector<ex>(f, 0));
+  ExMatrix Ca(eq.ydd.empty() ? 0 : r, std::vector<ex>(f, 0)), Du(eq.ydd.empty() ? 0 : r, std::vector<ex>(m, 0));
   for (std::size_t i = 0; i < r; ++i) {
     ex zi = prog.define(outputs[i]);
     for (std::size_t j = 0; j < f; ++j) {
       lin.Cy[i][j] = at(prog.diff(zi, eq.y[j]));
       lin.Cv[i][j] = at(prog.diff(zi, eq.yd[j]));
     }
+    if (eq.ydd.empty()) continue;  // only reaction outputs depend on ÿ and u
+    for (std::size_t j = 0; j < f; ++j) Ca[i][j] = at(prog.diff(zi, eq.ydd[j]));
+    for (std::size_t j = 0; j < m; ++j) Du[i][j] = at(prog.diff(zi, eq.u[j]));
   }
   for (std::size_t k = 0; k < f; ++k) lin.coordinates.push_back(k);
   if (loops) {
     reduce_linear(eq, residual_at_rest, lin.M, lin.Q, lin.K, lin.B, lin.Cy, lin.Cv);
+    Ca = reduce_columns(eq, Ca);
     f = eq.loops.independent.size();
     lin.coordinates = eq.loops.independent;
   }
@@ -203,6 +209,12 @@ LinearEquations linearize(Equations& eq) {
       }
       if (st.N_zero) lin.K[i][j] = lin.K[j][i];
     }
+  // C_a and D_u: kept only when some entry can be nonzero.
+  bool any = false;
+  for (const ExMatrix* A : {&Ca, &Du})
+    for (const auto& row : *A)
+      for (const auto& x : row) any = any || !x.is_zero();
+  if (any) lin.Ca = Ca, lin.Du = Du;
   split(lin.Q, lin.D, lin.G);
   split(lin.K, lin.Ks, lin.N);
   lin.zeros = find_structural_zeros(eq, lin);

@@ -36,8 +36,7 @@ struct RawEquation {
   ex size2;  // |r_a|² + |r_b|² (+ L²) for positional equations, 1 otherwise
 };
 
-std::vector<RawEquation> equations_of(const Model& model, Equations& eq, const Constraint& c) {
-  Program& prog = eq.program;
+std::vector<RawEquation> equations_of(const Model& model, Program& prog, const Kinematics& kin, const Constraint& c) {
   std::vector<RawEquation> out;
   ex size2 = 1;
   auto add = [&](const char* component, const ex& phi, bool positional) {
@@ -47,7 +46,6 @@ std::vector<RawEquation> equations_of(const Model& model, Equations& eq, const C
     add("", c.expression, false);
     return out;
   }
-  const Kinematics& kin = eq.kinematics;
   const Vec3 ra = kin.marker_position(model, prog, c.marker_a), rb = kin.marker_position(model, prog, c.marker_b);
   const Mat3 Sa = kin.marker_frame(model, prog, c.marker_a), Sb = kin.marker_frame(model, prog, c.marker_b);
   const Vec3 d = sub(rb, ra);
@@ -370,6 +368,13 @@ GiNaC::exmap refine(const Model& model, Equations& eq, const std::vector<RawEqua
 }  // namespace
 
 // -----------------------------------------------------------------------------------------------
+std::vector<ConstraintEquation> constraint_equations(const Model& model, Program& program, const Kinematics& kin) {
+  std::vector<ConstraintEquation> out;
+  for (const auto& c : model.constraints())
+    for (const auto& r : equations_of(model, program, kin, c)) out.push_back(r.equation);
+  return out;
+}
+
 std::vector<ex> LoopClosure::solve(Program& prog, const std::vector<ex>& b) const {
   const std::size_t m = rows.size();
   std::vector<ex> z(m);
@@ -419,7 +424,7 @@ LoopClosure close_loops(const Model& model, Equations& eq) {
 
   std::vector<RawEquation> raw;
   for (const auto& c : model.constraints())
-    for (auto& r : equations_of(model, eq, c)) {
+    for (auto& r : equations_of(model, prog, eq.kinematics, c)) {
       if (proved_zero(prog, r.equation.phi))
         loops.dropped.push_back({r.equation, "identically zero (the motion never violates it)"});
       else
@@ -541,6 +546,18 @@ void reduce_equations(Equations& eq) {
       if (!loops.X[d][j].is_zero()) v += loops.X[d][j] * eq.yd[loops.independent[j]];
     rates[eq.yd[loops.dependent[d]]] = prog.define(v);
   }
+  // Accelerations (for reaction outputs): ÿ_d = X ÿ_i + g_d, with g_d at ẏ_d = X ẏ_i.
+  if (!eq.ydd.empty()) {
+    Program::Substitution on_rates(rates);
+    GiNaC::exmap accelerations = rates;
+    for (std::size_t d = 0; d < loops.dependent.size(); ++d) {
+      ex v = prog.substitute(loops.g[d], on_rates);
+      for (std::size_t j = 0; j < loops.independent.size(); ++j)
+        if (!loops.X[d][j].is_zero()) v += loops.X[d][j] * eq.ydd[loops.independent[j]];
+      accelerations[eq.ydd[loops.dependent[d]]] = prog.define(v);
+    }
+    rates = accelerations;
+  }
   Program::Substitution sub(rates);
   auto on_motion = [&](const ex& e) { return prog.define(prog.substitute(e, sub)); };
 
@@ -560,6 +577,8 @@ void reduce_equations(Equations& eq) {
   eq.JT = times_T(prog, loops, eq.tree.JT);
   eq.JR = times_T(prog, loops, eq.tree.JR);
 }
+
+ExMatrix reduce_columns(Equations& eq, const ExMatrix& A) { return times_T(eq.program, eq.loops, A); }
 
 void reduce_linear(Equations& eq, const std::vector<ex>& residual_at_rest, ExMatrix& M, ExMatrix& Q, ExMatrix& K,
                    ExMatrix& B, ExMatrix& Cy, ExMatrix& Cv) {

@@ -566,6 +566,16 @@ void Model::validate() const {
         check_expr(o.expression, o.where, "an output expression", allowed);
         break;
       }
+      case OutputKind::reaction: {
+        bool joint = body_index_.count(o.reaction_of) > 0, constraint = false;
+        for (const auto& c : constraints_) constraint = constraint || c.name == o.reaction_of;
+        if (!joint && !constraint)
+          throw ModelError(o.where, "output '" + o.name + "' names '" + o.reaction_of +
+                                        "', which is neither a body (its joint) nor a constraint of this model");
+        if (!o.frame_marker.empty()) check_marker(o.frame_marker, o.where, "output '" + o.name + "'");
+        for (const auto& x : o.direction) check_expr(x, o.where, "an output direction", parameters_only);
+        break;
+      }
       case OutputKind::force:
         validate_force_output(o);
         for (const auto& x : o.direction) check_expr(x, o.where, "an output direction", parameters_only);

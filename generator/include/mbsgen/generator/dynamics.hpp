@@ -22,6 +22,8 @@ struct Equations {
   Program program;
   Kinematics kinematics;
   std::vector<GiNaC::symbol> y, yd, u, p;  ///< coordinates, rates, inputs, parameters
+  /// Accelerations ÿ (`NAME_ddot`), variables only when outputs depend on them (reactions.hpp).
+  std::vector<GiNaC::symbol> ydd;
   ExMatrix M;                               ///< f×f mass matrix M(y)
   std::vector<GiNaC::ex> residual;          ///< k(y, ẏ) − q(y, ẏ, u), length f
   std::vector<GiNaC::ex> outputs;           ///< z(y, ẏ), one per model output

@@ -23,6 +23,9 @@ struct LinearEquations {
   std::vector<std::size_t> coordinates;
   ExMatrix M, Q, K, B, Cy, Cv;  ///< f×f, f×f, f×f, f×m, r×f, r×f (expressions in y, ẏ, p)
   ExMatrix D, G, Ks, N;         ///< sym Q, skew Q, sym K, skew K
+  /// Outputs that depend on accelerations and inputs (reaction forces, reactions.hpp):
+  /// z_s = C_y y_s + C_v y_s' + C_a y_s'' + D_u u. Empty when no output does.
+  ExMatrix Ca, Du;              ///< r×f, r×m
   std::vector<GiNaC::ex> y0, yd0;  ///< default operating point (expressions in p)
   bool equilibrium = false;     ///< y0 is an initial guess for a static equilibrium
   /// D, G, N vanish at the operating point for all parameter values (the manifest's

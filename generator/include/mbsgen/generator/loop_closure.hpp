@@ -64,6 +64,9 @@ struct LoopClosure {
   ExMatrix L, U;
 };
 
+/// Every equation of the model's constraints (none dropped), written with the kinematics `kin`.
+std::vector<ConstraintEquation> constraint_equations(const Model& model, Program& program, const Kinematics& kin);
+
 /// Builds the constraint equations of a derived model, drops those that vanish identically,
 /// checks the operating point (a `given` one must close the loops), chooses or checks the
 /// independent coordinates and factors Φ_yd. Throws ModelError for a singular Jacobian at the
@@ -82,5 +85,8 @@ void reduce_equations(Equations& eq);
 /// `residual_at_rest` is (k − q)(y, 0, 0) of the tree.
 void reduce_linear(Equations& eq, const std::vector<GiNaC::ex>& residual_at_rest, ExMatrix& M, ExMatrix& Q,
                    ExMatrix& K, ExMatrix& B, ExMatrix& Cy, ExMatrix& Cv);
+
+/// A T: the columns of the tree's coordinates become those of the independent ones.
+ExMatrix reduce_columns(Equations& eq, const ExMatrix& A);
 
 }  // namespace mbsgen

@@ -185,7 +185,7 @@ struct Constraint {
   SourceLocation where;
 };
 
-enum class OutputKind { position, velocity, coordinate, rate, expression, force };
+enum class OutputKind { position, velocity, coordinate, rate, expression, force, reaction };
 
 /// What a `force` output measures of its force elements.
 enum class ForceQuantity { force, torque };
@@ -203,8 +203,15 @@ struct Output {
   /// directionᵀ (that vector) with direction in the world frame, or in the frame of marker b of
   /// the first element when force_frame is marker.
   std::vector<std::string> elements;
-  ForceQuantity quantity = ForceQuantity::force;
+  ForceQuantity quantity = ForceQuantity::force;  ///< force and reaction
   ForceFrame force_frame = ForceFrame::world;
+  /// reaction: the load a joint transmits (reactions.hpp), as directionᵀ (force [N] or torque
+  /// [N m]) with direction in the world frame, or in the frame of `frame_marker` when given.
+  /// `reaction_of` names a body (the joint to its parent: the load the parent exerts on the body,
+  /// torque about the body frame's origin) or a constraint (the load on the body of its marker b;
+  /// for an expression constraint, its multiplier λ times direction[0]).
+  std::string reaction_of;
+  std::string frame_marker;
   std::string unit;
   SourceLocation where;
 };
@@ -333,6 +340,8 @@ struct CallSite {
 class Model;
 /// The model as one of its scenes sees it (scene.hpp).
 Model apply_scene(const Model& model, const std::string& scene);
+/// The model with six probe coordinates in the joints of the named bodies (reactions.hpp).
+Model with_joint_probes(const Model& model, const std::vector<std::string>& bodies);
 
 /// A multibody model. Add parameters, coordinates and inputs first (they create the symbols that
 /// expressions use), then bodies, markers, forces and outputs. `validate()` checks the whole.
@@ -428,6 +437,7 @@ class Model {
 
  private:
   friend Model apply_scene(const Model& model, const std::string& scene);
+  friend Model with_joint_probes(const Model& model, const std::vector<std::string>& bodies);
 
   void check_new_symbol(const std::string& name, const SourceLocation& where);
   void check_new_element(const std::string& name, const char* kind, const SourceLocation& where);
