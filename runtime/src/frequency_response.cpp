@@ -453,11 +453,60 @@ struct FrequencyResponse::Impl {
   Index n;
   // selected input/outputs for the current compute()
   Eigen::VectorXd b;
-  Eigen::MatrixXcd Cy, Cv;  // p×n, complex copies so that products do not allocate
-  Eigen::MatrixXd Cy_re, Cv_re;  // p×n real
-  Eigen::VectorXcd z;       // p
+  // The rows every method computes, ẑ_r = (C_y + iΩC_v)_r ŷ: the p selected outputs, then one
+  // pseudo-row per selected output with a nonzero row of C_a (C_y := that row, C_v := 0), so
+  // that the methods need not know C_a; combine_outputs() adds −Ω²·(C_a ŷ) and D(:, input).
+  Eigen::MatrixXcd Cy, Cv;  // (p + q)×n, complex copies so that products do not allocate
+  Eigen::MatrixXd Cy_re, Cv_re;  // (p + q)×n real
+  Eigen::VectorXcd z;       // p + q
+  std::vector<Index> acc_row;  // per output r < p: its pseudo-row in z, or −1
+  Eigen::VectorXd feed;        // per output r < p: D(row, input), 0 without D
+  bool combine = false;        // some pseudo-row or nonzero feedthrough: combine_outputs needed
 
   explicit Impl(const LinearModel& m) : model(m), n(m.size()) {}
+
+  /// Selects input column `input` and the output `rows` (validated by the caller): b, the rows
+  /// above, acc_row, feed and combine. Without C_a and D (or with zero rows) exactly the old
+  /// rows and no combination step.
+  void select_outputs(const std::vector<Index>& rows, Index input) {
+    const Index p = static_cast<Index>(rows.size());
+    b = model.B().col(input);
+    acc_row.assign(rows.size(), -1);
+    feed.setZero(p);
+    Index q = 0;
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      if (model.has_output_accelerations() && (model.C_a().row(rows[r]).array() != 0.0).any())
+        acc_row[r] = p + q++;
+      if (model.has_feedthrough()) feed[static_cast<Index>(r)] = model.D()(rows[r], input);
+    }
+    combine = q > 0 || (feed.array() != 0.0).any();
+    Cy.resize(p + q, n);
+    Cv.resize(p + q, n);
+    for (Index r = 0; r < p; ++r) {
+      const Index row = rows[static_cast<std::size_t>(r)];
+      Cy.row(r) = model.C_y().row(row).cast<cd>();
+      Cv.row(r) = model.C_v().row(row).cast<cd>();
+      const Index a = acc_row[static_cast<std::size_t>(r)];
+      if (a >= 0) {
+        Cy.row(a) = model.C_a().row(row).cast<cd>();
+        Cv.row(a).setZero();
+      }
+    }
+    z.resize(p + q);
+    Cy_re = Cy.real();
+    Cv_re = Cv.real();
+  }
+
+  /// ẑ_r = (C_y + iΩC_v)_r ŷ − Ω²(C_a ŷ)_r + D(r, input) for the p outputs, in place in z's
+  /// first p entries (the pseudo-rows are read before being overwritten: their index is ≥ p).
+  void combine_outputs(double om) {
+    const double om2 = om * om;
+    for (std::size_t r = 0; r < acc_row.size(); ++r) {
+      const Index i = static_cast<Index>(r);
+      if (acc_row[r] >= 0) z[i] -= om2 * z[acc_row[r]];
+      if (feed[i] != 0.0) z[i] += feed[i];
+    }
+  }
 
   // ---- direct ----
   bool direct_ready = false;
@@ -1181,16 +1230,7 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
       throw NonFiniteError(s.str());
     }
   const Index p = static_cast<Index>(rows.size());
-  im.b = model_.B().col(input);
-  im.Cy.resize(p, n);
-  im.Cv.resize(p, n);
-  for (Index r = 0; r < p; ++r) {
-    im.Cy.row(r) = model_.C_y().row(rows[static_cast<std::size_t>(r)]).cast<cd>();
-    im.Cv.row(r) = model_.C_v().row(rows[static_cast<std::size_t>(r)]).cast<cd>();
-  }
-  im.z.resize(p);
-  im.Cy_re = im.Cy.real();
-  im.Cv_re = im.Cv.real();
+  im.select_outputs(rows, input);
 
   FrfMethod m = options_.method;
   if (m == FrfMethod::automatic) m = automatic_frf_method(model_, omega.size());
@@ -1259,6 +1299,7 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
       case FrfMethod::real: ok = im.point_real(om, rc); break;
       case FrfMethod::automatic: break;
     }
+    if (ok && im.combine) im.combine_outputs(om);
     rcond_[k] = rc;
     FrfFlag flag = FrfFlag::ok;
     // `real` solves the squared system Ω²E + A², whose rcond is about the square of the complex
@@ -1278,7 +1319,7 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
       }
       response_.col(k).setConstant(cd(kNaN, kNaN));
     } else {
-      response_.col(k) = im.z;
+      response_.col(k) = im.z.head(p);
     }
   }
   info_ = Eigen::Success;

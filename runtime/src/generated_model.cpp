@@ -173,11 +173,16 @@ LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
                   range + "): a negative mass or inertia?");
     }
   }
-  return LinearModel(std::move(M), std::move(Q), std::move(K), std::move(B), std::move(Cy),
-                     std::move(Cv), name_list(k_.coordinate_names, k_.n_coordinates),
-                     name_list(k_.input_names, k_.n_inputs), name_list(k_.output_names, k_.n_outputs),
-                     name_list(k_.coordinate_units, k_.n_coordinates),
-                     name_list(k_.input_units, k_.n_inputs), name_list(k_.output_units, k_.n_outputs));
+  LinearModel lin(std::move(M), std::move(Q), std::move(K), std::move(B), std::move(Cy),
+                  std::move(Cv), name_list(k_.coordinate_names, k_.n_coordinates),
+                  name_list(k_.input_names, k_.n_inputs), name_list(k_.output_names, k_.n_outputs),
+                  name_list(k_.coordinate_units, k_.n_coordinates),
+                  name_list(k_.input_units, k_.n_inputs), name_list(k_.output_units, k_.n_outputs));
+  if (!k_.output_terms) return lin;
+  Eigen::MatrixXd Ca(r, f), D(r, m);
+  check_status(k_.output_terms(op.y0.data(), op.yd0.data(), p_.data(), ptr(Ca), ptr(D)),
+               "output_terms", k_.model);
+  return lin.with_output_terms(std::move(Ca), std::move(D));
 }
 
 }  // namespace mbsgen

@@ -27,7 +27,7 @@ struct Common {
 };
 
 LinearModel load(const Common& c, const std::string& Bf, const std::string& Cf,
-                 const std::string& Cvf) {
+                 const std::string& Cvf, const std::string& Caf = "", const std::string& Df = "") {
   Eigen::MatrixXd M = read_matrix_market(c.M);
   Eigen::MatrixXd K = read_matrix_market(c.K);
   Eigen::MatrixXd Q = c.Q.empty() ? Eigen::MatrixXd() : read_matrix_market(c.Q);
@@ -35,8 +35,12 @@ LinearModel load(const Common& c, const std::string& Bf, const std::string& Cf,
                                  : read_matrix_market(Bf);
   Eigen::MatrixXd Cy = Cf.empty() ? Eigen::MatrixXd() : read_matrix_market(Cf);
   Eigen::MatrixXd Cv = Cvf.empty() ? Eigen::MatrixXd() : read_matrix_market(Cvf);
-  return LinearModel(std::move(M), std::move(Q), std::move(K), std::move(B), std::move(Cy),
-                     std::move(Cv));
+  LinearModel model(std::move(M), std::move(Q), std::move(K), std::move(B), std::move(Cy),
+                    std::move(Cv));
+  if (Caf.empty() && Df.empty()) return model;
+  Eigen::MatrixXd Ca = Caf.empty() ? Eigen::MatrixXd() : read_matrix_market(Caf);
+  Eigen::MatrixXd D = Df.empty() ? Eigen::MatrixXd() : read_matrix_market(Df);
+  return model.with_output_terms(std::move(Ca), std::move(D));
 }
 
 int run_modes(const Common& c, bool all, std::ostream& out) {
@@ -52,13 +56,13 @@ int run_modes(const Common& c, bool all, std::ostream& out) {
 }
 
 struct FrfArgs {
-  std::string B, C, Cv, method = "auto", spacing = "log", on_pole = "flag";
+  std::string B, C, Cv, Ca, D, method = "auto", spacing = "log", on_pole = "flag";
   long input = 1, output = 1, points = 200;
   double from = 1.0, to = 1000.0;
 };
 
 int run_frf(const Common& c, const FrfArgs& a, std::ostream& out, std::ostream& err) {
-  const LinearModel model = load(c, a.B, a.C, a.Cv);
+  const LinearModel model = load(c, a.B, a.C, a.Cv, a.Ca, a.D);
   // Out of the model's range: a usage error (exit status 2), like an unknown name for a solver.
   if (a.input < 1 || a.input > model.num_inputs())
     throw NameError("--input " + std::to_string(a.input) + " out of range 1.." +
@@ -85,7 +89,7 @@ int run_frf(const Common& c, const FrfArgs& a, std::ostream& out, std::ostream& 
 
 int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) try {
   CLI::App app{"mbsgen linear: modes and frequency responses of M y'' + Q y' + K y = B u, "
-               "z = C y, from Matrix Market files"};
+               "z = C y + Cv y' + Ca y'' + D u, from Matrix Market files"};
   app.name("mbsgen linear");
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("mbsgen linear ") + kRuntimeVersion, "print the version and exit");
@@ -112,6 +116,8 @@ int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) try
 ;
   frf->add_option("--Cv", a.Cv, "velocity output matrix C_v (p x f); default 0")
 ;
+  frf->add_option("--Ca", a.Ca, "acceleration output matrix C_a (p x f); default 0");
+  frf->add_option("--D", a.D, "feedthrough matrix D (p x m), z += D u; default 0");
   frf->add_option("--input", a.input, "input: column of B, 1-based")->check(CLI::Range(1L, 1000000000L));
   frf->add_option("--output", a.output, "output: row of C, 1-based")->check(CLI::Range(1L, 1000000000L));
   frf->add_option("--from", a.from, "first frequency [Hz]")->check(frequency_hz());

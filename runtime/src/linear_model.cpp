@@ -13,22 +13,22 @@ std::string dims(const Eigen::MatrixXd& A) {
   return s.str();
 }
 
-void check_finite(const Eigen::MatrixXd& A, const char* name) {
+void check_finite(const Eigen::MatrixXd& A, const char* name, const char* who = "LinearModel") {
   for (Eigen::Index j = 0; j < A.cols(); ++j)
     for (Eigen::Index i = 0; i < A.rows(); ++i)
       if (!std::isfinite(A(i, j))) {
         std::ostringstream s;
-        s << "LinearModel: " << name << " (" << dims(A) << ") has a non-finite entry " << A(i, j)
+        s << who << ": " << name << " (" << dims(A) << ") has a non-finite entry " << A(i, j)
           << " at (" << i + 1 << "," << j + 1 << ")";
         throw NonFiniteError(s.str());
       }
 }
 
 void check_dims(const Eigen::MatrixXd& A, Eigen::Index r, Eigen::Index c, const char* name,
-                const char* expected) {
+                const char* expected, const char* who = "LinearModel") {
   if (A.rows() != r || A.cols() != c) {
     std::ostringstream s;
-    s << "LinearModel: " << name << " is " << dims(A) << " but must be " << r << "x" << c << " ("
+    s << who << ": " << name << " is " << dims(A) << " but must be " << r << "x" << c << " ("
       << expected << ")";
     throw DimensionError(s.str());
   }
@@ -121,6 +121,21 @@ LinearModel::LinearModel(Eigen::MatrixXd M, Eigen::MatrixXd Q, Eigen::MatrixXd K
     : LinearModel(M, std::move(Q), std::move(K),
                   Eigen::MatrixXd::Identity(M.rows(), M.rows()), Eigen::MatrixXd(),
                   Eigen::MatrixXd()) {}
+
+LinearModel LinearModel::with_output_terms(Eigen::MatrixXd C_a, Eigen::MatrixXd D) const {
+  constexpr const char* who = "LinearModel::with_output_terms";
+  const Eigen::Index p = num_outputs(), f = size(), m = num_inputs();
+  auto is_empty = [](const Eigen::MatrixXd& A) { return A.rows() == 0 && A.cols() == 0; };
+  if (!is_empty(C_a)) check_dims(C_a, p, f, "C_a", "p x f, the size of C_y", who);
+  if (!is_empty(D)) check_dims(D, p, m, "D", "p x m, one row per output, one column per input", who);
+  check_finite(C_a, "C_a", who);
+  check_finite(D, "D", who);
+  LinearModel copy(*this);
+  // Exactly zero is stored empty: analyses then take the path of a model without the terms.
+  copy.C_a_ = (C_a.array() != 0.0).any() ? std::move(C_a) : Eigen::MatrixXd();
+  copy.D_ = (D.array() != 0.0).any() ? std::move(D) : Eigen::MatrixXd();
+  return copy;
+}
 
 bool LinearModel::is_symmetric_undamped() const {
   return !has_Q_ && M_ == M_.transpose() && K_ == K_.transpose();

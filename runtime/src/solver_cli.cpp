@@ -170,8 +170,11 @@ void json_names(std::ostream& out, const std::vector<std::string>& v) {
 int run_matrices(const ModelKernels& k, const Options& o, std::ostream& out, std::ostream& err) {
   GeneratedModel model = configured(k, o);
   const LinearModel lin = model.linear_model();
-  const std::pair<const char*, const Eigen::MatrixXd*> mats[] = {
+  std::vector<std::pair<const char*, const Eigen::MatrixXd*>> mats = {
       {"M", &lin.M()}, {"Q", &lin.Q()}, {"K", &lin.K()}, {"B", &lin.B()}, {"C_y", &lin.C_y()}, {"C_v", &lin.C_v()}};
+  // Outputs on ÿ and u (joint loads; the kernels' optional output_terms): only when nonzero.
+  if (lin.has_output_accelerations()) mats.push_back({"C_a", &lin.C_a()});
+  if (lin.has_feedthrough()) mats.push_back({"D", &lin.D()});
   if (o.format == "mtx") {
     namespace fs = std::filesystem;
     const fs::path dir = o.out_dir.empty() ? fs::path(".") : fs::path(o.out_dir);
@@ -266,7 +269,7 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   CLI::App* stat = app.add_subcommand("static", "the operating point: equilibrium, residual, iterations");
   add_set(stat);
   stat->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json"}));
-  CLI::App* matrices = app.add_subcommand("matrices", "M, Q, K, B, C_y, C_v at the operating point");
+  CLI::App* matrices = app.add_subcommand("matrices", "M, Q, K, B, C_y, C_v (C_a, D) at the operating point");
   add_set(matrices);
   matrices->add_option("--format", o.format, "json (standard output) or mtx (files in --out)")
       ->check(CLI::IsMember({"json", "mtx"}));

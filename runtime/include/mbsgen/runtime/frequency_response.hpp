@@ -1,6 +1,8 @@
-// Frequency response of  M ÿ + Q ẏ + K y = B u,  z = C_y y + C_v ẏ  (seed eqs. 3.18-3.23,
-// DESIGN.md §2): for u_j = e_j cos(Ωt − φ_j) the stationary output is z = Re(ẑ e^{iΩt}) with
-//     (K − Ω²M + iΩQ) ŷ = b_j,   ẑ = (C_y + iΩ C_v) ŷ      (b_j: column j of B, per unit input).
+// Frequency response of  M ÿ + Q ẏ + K y = B u,  z = C_y y + C_v ẏ + C_a ÿ + D u  (seed eqs.
+// 3.18-3.23, DESIGN.md §2): for u_j = e_j cos(Ωt − φ_j) the stationary output is z = Re(ẑ e^{iΩt})
+//     (K − Ω²M + iΩQ) ŷ = b_j,   ẑ = (C_y + iΩ C_v − Ω² C_a) ŷ + d_j
+// (b_j, d_j: column j of B and D, per unit input; C_a and D are zero unless the model has them,
+// e.g. joint loads, issue 15 §3).
 #pragma once
 
 #include <Eigen/Core>
@@ -130,7 +132,13 @@ class FrequencyResponse {
 
   /// Computes ẑ(Ω) for the angular frequencies omega (rad/s, any order, ≥ 0), input column
   /// `input` (0-based) of B and the output rows `outputs` (0-based rows of C_y, C_v; empty means
-  /// all). Throws DimensionError for bad indices, SingularSystemError at a pole when
+  /// all). Every method gives ẑ = (C_y + iΩC_v − Ω²C_a) ŷ + D(:, input): an output with a
+  /// nonzero row of C_a is computed as two rows, C_y + iΩC_v and C_a (a pseudo-row the method
+  /// solves like any output), combined after each frequency; rcond and the flags are those of
+  /// the solve for ŷ (the combination, like C_y ŷ, is an ordinary sum rounded to about
+  /// u·(|(C_y + iΩC_v)ŷ| + Ω²|C_a ŷ| + |d|), which may cancel: an output that is exactly zero
+  /// by the equations of motion comes out at that rounding level). A model without C_a and D
+  /// takes the path it took before they existed. Throws DimensionError for bad indices, SingularSystemError at a pole when
   /// on_pole == raise, IllConditionedError/SingularSystemError when modal cannot be used.
   FrequencyResponse& compute(const Eigen::VectorXd& omega, Eigen::Index input,
                              const std::vector<Eigen::Index>& outputs = {});

@@ -49,6 +49,13 @@ struct ModelKernels {
   int default_points = 0;                   ///< the scene's number of frequencies (0: none given)
   bool default_linear_spacing = false;      ///< the scene's spacing is linear (else logarithmic)
   const char* generator_version = nullptr;  ///< mbsgen version that generated the kernels, or null
+  /// Optional (null: the outputs depend on y and ẏ only): the output terms z += C_a ÿ + D u of
+  /// outputs that depend on the accelerations or directly on the inputs (joint loads, issue 15
+  /// §3), at the operating point, column-major: Ca n_outputs×n_coordinates, D
+  /// n_outputs×n_inputs. Returns a status like `linear`. Trailing, so the ABI version is
+  /// unchanged (docs/generated-abi.md).
+  int (*output_terms)(const double* y0, const double* yd0, const double* p, double* Ca,
+                      double* D) = nullptr;
 };
 
 /// The first n entries of a kernel name array (null entries become "").
@@ -99,7 +106,8 @@ class GeneratedModel {
   /// when a kernel returns a non-finite value.
   OperatingPoint operating_point() const;
 
-  /// M, Q, K, B, C_y, C_v at the operating point, with names and units. Throws NonFiniteError
+  /// M, Q, K, B, C_y, C_v (and C_a, D when the kernels have `output_terms`) at the operating
+  /// point, with names and units. Throws NonFiniteError
   /// when a kernel returns a non-finite value, and Error when M is not positive semi-definite
   /// (smallest eigenvalue below −1e-12·n·‖M‖): no mass distribution gives that, so a parameter
   /// set this way (a negative mass or inertia) would give numbers that only look like results.

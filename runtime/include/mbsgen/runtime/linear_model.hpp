@@ -1,4 +1,5 @@
-// The linear(ized) model  M ÿ + Q ẏ + K y = B u,  z = C_y y + C_v ẏ  (seed eqs. 3.8-3.10).
+// The linear(ized) model  M ÿ + Q ẏ + K y = B u,  z = C_y y + C_v ẏ + C_a ÿ + D u
+// (seed eqs. 3.8-3.10; C_a and D for joint loads, issue 15 §3).
 #pragma once
 
 #include <Eigen/Dense>
@@ -12,12 +13,15 @@ namespace mbsgen {
 /// Read-only description of a linear second-order model with f coordinates, m inputs and
 /// p outputs (seed eq. 3.8, DESIGN.md §2):
 ///
-///     M ÿ + Q ẏ + K y = B u,      z = C_y y + C_v ẏ.
+///     M ÿ + Q ẏ + K y = B u,      z = C_y y + C_v ẏ + C_a ÿ + D u.
 ///
 /// - M (f×f, kg or kg·m², per coordinate): mass matrix, may be singular (massless coordinates);
 /// - Q (f×f, N·s/m ...): velocity matrix, damping D = sym(Q) plus gyroscopic G = skew(Q);
 /// - K (f×f, N/m ...): stiffness, symmetric part plus circulatory N = skew(K);
-/// - B (f×m): input matrix; C_y, C_v (p×f): output matrices.
+/// - B (f×m): input matrix; C_y, C_v (p×f): output matrices;
+/// - C_a (p×f) and D (p×m), optional (with_output_terms): outputs that depend on the
+///   accelerations and directly on the inputs, such as joint loads (issue 15 §3 (c)). Without
+///   them (the constructors) both are zero and stored empty (0×0).
 ///
 /// The constructor validates dimensions and finiteness and throws DimensionError or
 /// NonFiniteError naming the function, the matrix and its dimensions. Names and units are
@@ -50,6 +54,20 @@ class LinearModel {
   const Eigen::MatrixXd& C_y() const { return C_y_; }  ///< p×f output matrix on y
   const Eigen::MatrixXd& C_v() const { return C_v_; }  ///< p×f output matrix on ẏ
 
+  /// p×f output matrix on ÿ, or 0×0 when it is zero (has_output_accelerations() false).
+  const Eigen::MatrixXd& C_a() const { return C_a_; }
+  /// p×m feedthrough of the inputs into the outputs, or 0×0 when it is zero (has_feedthrough()
+  /// false).
+  const Eigen::MatrixXd& D() const { return D_; }
+  bool has_output_accelerations() const { return C_a_.size() != 0; }  ///< C_a ≠ 0
+  bool has_feedthrough() const { return D_.size() != 0; }             ///< D ≠ 0
+
+  /// A copy of this model whose outputs are z = C_y y + C_v ẏ + C_a ÿ + D u (these C_a and D
+  /// replace any it had). C_a must be p×f and D p×m, or empty (0×0, meaning zero); an exactly zero matrix is stored empty, so that analyses keep
+  /// the path of a model without it. Throws DimensionError or NonFiniteError naming
+  /// "LinearModel::with_output_terms", the matrix and its dimensions.
+  LinearModel with_output_terms(Eigen::MatrixXd C_a, Eigen::MatrixXd D) const;
+
   bool has_damping() const { return has_Q_; }  ///< false when Q is exactly zero
   /// True when M and K are exactly symmetric and Q is exactly zero (fast path of the modes).
   bool is_symmetric_undamped() const;
@@ -66,6 +84,7 @@ class LinearModel {
 
  private:
   Eigen::MatrixXd M_, Q_, K_, B_, C_y_, C_v_;
+  Eigen::MatrixXd C_a_, D_;  // 0×0 when zero
   std::vector<std::string> coordinate_names_, input_names_, output_names_;
   std::vector<std::string> coordinate_units_, input_units_, output_units_;
   bool has_Q_ = false;
