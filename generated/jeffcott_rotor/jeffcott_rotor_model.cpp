@@ -24,7 +24,7 @@ const mbsgen::ModelKernels& kernels() {
       jeffcott_rotor_coordinate_names, coordinate_units, jeffcott_rotor_parameter_names, parameter_units, jeffcott_rotor_parameter_defaults,
       jeffcott_rotor_input_names, input_units, jeffcott_rotor_output_names, output_units,
       &jeffcott_rotor_operating_point, &jeffcott_rotor_linear, &jeffcott_rotor_residual, &jeffcott_rotor_mass_matrix,
-      0, false, "0.1.0"};
+      0, false, "0.1.0", nullptr, &jeffcott_rotor_outputs};
   return k;
 }
 

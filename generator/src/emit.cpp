@@ -608,8 +608,8 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
       if (!loops || std::binary_search(eq.loops.independent.begin(), eq.loops.independent.end(), k))
         ydd.push_back(eq.ydd[k]);
   }
-  kernels.push_back({"outputs", "outputs z(y, yd) (at ydd = 0, u = 0): length r", {{"y", y}, {"yd", yd}, {"p", p}},
-                     {{"z", z, ""}}});
+  kernels.push_back({"outputs", eq.ydd.empty() ? "outputs z(y, yd): length r" : "outputs z(y, yd) (at ydd = 0, u = 0): length r",
+                     {{"y", y}, {"yd", yd}, {"p", p}}, {{"z", z, ""}}});
   if (!eq.ydd.empty())
     kernels.push_back({"outputs_general", "outputs z(y, yd, ydd, u): length r (reaction forces need ydd and u)",
                        {{"y", y}, {"yd", yd}, {"ydd", ydd}, {"u", u}, {"p", p}},

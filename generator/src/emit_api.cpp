@@ -146,7 +146,10 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     << id << "_parameter_defaults,\n      " << id << "_input_names, input_units, " << id
     << "_output_names, output_units,\n      " << kernel("operating_point") << ", " << kernel("linear")
     << ", " << kernel("residual") << ", " << kernel("mass_matrix") << ",\n      " << points << ", "
-    << (linear_spacing ? "true" : "false") << ", " << literal(kGeneratorVersion) << "};\n  return k;\n}\n\n";
+    << (linear_spacing ? "true" : "false") << ", " << literal(kGeneratorVersion);
+  // Trailing optional kernels: C_a and D of reaction outputs, and the nonlinear outputs.
+  c << ", " << kernel("output_terms") << ", " << kernel("outputs");
+  c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"
        "  return m;\n}\n\n";

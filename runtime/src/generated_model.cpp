@@ -147,6 +147,18 @@ OperatingPoint GeneratedModel::operating_point() const {
   return op;
 }
 
+Eigen::VectorXd GeneratedModel::outputs(const OperatingPoint& op) const {
+  if (!k_.outputs) return {};
+  if (op.y0.size() != size() || op.yd0.size() != size())
+    throw DimensionError("GeneratedModel::outputs: operating point of size " + std::to_string(op.y0.size()) + "/" +
+                         std::to_string(op.yd0.size()) + " for a model with " + std::to_string(size()) +
+                         " coordinates");
+  Eigen::VectorXd z(std::max<Eigen::Index>(k_.n_outputs, 1));
+  check_status(k_.outputs(op.y0.data(), op.yd0.data(), p_.data(), z.data()), "outputs", k_.model);
+  z.conservativeResize(k_.n_outputs);
+  return z;
+}
+
 LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
   const Eigen::Index f = size(), m = k_.n_inputs, r = k_.n_outputs;
   if (op.y0.size() != f || op.yd0.size() != f)

@@ -138,7 +138,16 @@ int run_static(const ModelKernels& k, const Options& o, std::ostream& out) {
     out << "},\"rates\":{";
     for (std::size_t i = 0; i < names.size(); ++i)
       out << (i ? "," : "") << json_string(names[i]) << ":" << num(op.yd0[static_cast<Eigen::Index>(i)], true);
-    out << "}}\n";
+    out << "}";
+    const Eigen::VectorXd z = model.outputs(op);
+    if (z.size() > 0) {
+      const auto outputs = name_list(k.output_names, k.n_outputs);
+      out << ",\"outputs\":{";
+      for (std::size_t i = 0; i < outputs.size(); ++i)
+        out << (i ? "," : "") << json_string(outputs[i]) << ":" << num(z[static_cast<Eigen::Index>(i)], true);
+      out << "}";
+    }
+    out << "}\n";
     return 0;
   }
   out << pad("coordinate", 16) << pad("y0", 26) << pad("yd0", 26) << "  unit\n";
@@ -148,6 +157,15 @@ int run_static(const ModelKernels& k, const Options& o, std::ostream& out) {
         << unit_or(k.coordinate_units, static_cast<Eigen::Index>(i), "-") << "\n";
   out << "# " << (op.equilibrium ? "static equilibrium, " : "operating point given by the model, ")
       << "residual norm " << short_num(op.residual_norm) << ", Newton iterations " << op.iterations << "\n";
+  // The outputs there: for joint loads (type reaction), the static loads.
+  const Eigen::VectorXd z = model.outputs(op);
+  if (z.size() > 0) {
+    const auto outputs = name_list(k.output_names, k.n_outputs);
+    out << "\n" << pad("output", 16) << pad("value", 26) << "  unit\n";
+    for (std::size_t i = 0; i < outputs.size(); ++i)
+      out << pad(outputs[i], 16) << pad(num(z[static_cast<Eigen::Index>(i)], false), 26) << "  "
+          << unit_or(k.output_units, static_cast<Eigen::Index>(i), "-") << "\n";
+  }
   return 0;
 }
 

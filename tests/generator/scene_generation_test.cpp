@@ -157,7 +157,7 @@ TEST(Scenes, ApiCarriesTheSceneSweepAndTheGeneratorVersion) {
   ASSERT_TRUE(r.has_value());
   const GeneratedApi api = emit_api(spinning.model, spinning.lin, spinning.code, "spinning", r->from_hz,
                                     r->to_hz, r->points, !r->logarithmic);
-  EXPECT_NE(api.source.find("400, false, \"" + std::string(kGeneratorVersion) + "\"};"), std::string::npos)
+  EXPECT_NE(api.source.find("400, false, \"" + std::string(kGeneratorVersion) + "\""), std::string::npos)
       << api.source;
 }
 

@@ -56,6 +56,9 @@ struct ModelKernels {
   /// unchanged (docs/generated-abi.md).
   int (*output_terms)(const double* y0, const double* yd0, const double* p, double* Ca,
                       double* D) = nullptr;
+  /// Optional (null: not recorded): the outputs z(y, ẏ) at any state (for outputs that depend
+  /// on ÿ and u, at ÿ = 0 and u = 0: the static loads that `static` prints). Trailing.
+  int (*outputs)(const double* y, const double* yd, const double* p, double* z) = nullptr;
 };
 
 /// The first n entries of a kernel name array (null entries become "").
@@ -113,6 +116,9 @@ class GeneratedModel {
   /// set this way (a negative mass or inertia) would give numbers that only look like results.
   LinearModel linear_model(const OperatingPoint& op) const;
   LinearModel linear_model() const { return linear_model(operating_point()); }
+  /// The outputs z at the operating point (for outputs that depend on ÿ and u: at ÿ = 0 and
+  /// u = 0, the static loads); empty when the kernels do not provide `outputs`.
+  Eigen::VectorXd outputs(const OperatingPoint& op) const;
 
  private:
   Eigen::VectorXd residual(const Eigen::VectorXd& y, const Eigen::VectorXd& yd) const;
