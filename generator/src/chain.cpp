@@ -156,6 +156,22 @@ Model four_bar_linkage() {
   model.add_gravity({"gravity", {GiNaC::ex(0), -g, GiNaC::ex(0)}, {}});
   model.add_spring({"spring", "anchor", "coupler_middle", k, L0, {}});
   add_revolute(model, "pin", "coupler_end", "rocker_tip");
+  // A torque on the crank as input; the loads at the pin and the crank's pivot as outputs.
+  const GiNaC::ex T = model.add_input("T", "N m");
+  model.add_generalized_force({"drive", "th1", T, {}, Category::generalized});
+  auto load = [&](const std::string& name, const std::string& of, Vec3 direction) {
+    Output o;
+    o.name = name;
+    o.kind = OutputKind::reaction;
+    o.reaction_of = of;
+    o.direction = direction;
+    o.unit = "N";
+    model.add_output(o);
+  };
+  load("pin_fx", "pin", {1, 0, 0});
+  load("pin_fy", "pin", {0, 1, 0});
+  load("pivot_fx", "crank", {1, 0, 0});
+  load("pivot_fy", "crank", {0, 1, 0});
   // Initial guess of the equilibrium: the loop closed at crank angle theta1 (the intersection
   // of the circles about the crank's tip and the rocker's pivot, elbow up).
   const double Ax = l1 * std::cos(theta1), Ay = l1 * std::sin(theta1);

@@ -5,12 +5,14 @@
 #include "four_bar_linkage.hpp"
 #include "ladder_3.hpp"
 
+#include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/generated_model.hpp"
 #include "mbsgen/runtime/linear_model.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 #include <string>
 #include <vector>
 
@@ -28,9 +30,19 @@ namespace {
 constexpr double kTheta0 = 1.256311620944826482631333;       // crank angle th1 at the equilibrium
 constexpr double kOmega2 = 115.2470787951297394601392;       // [1/s²]
 constexpr double kOmega2Wrong = 171.0001009042161920595596;  // without the geometric stiffness
+// Static loads by statics of the rocker and the coupler (moments about their pivots) [N].
+constexpr double kPin[2] = {-0.3105781941863467975117627, 2.916876196288909572518942};
+constexpr double kPivot[2] = {-0.6116646951934536065438293, -0.4089278602473552914115706};
+
+mbsgen::ModelKernels four_bar_kernels() {
+  mbsgen::ModelKernels k = LOOP_KERNELS(four_bar_linkage);
+  k.output_terms = four_bar_linkage_output_terms;
+  k.outputs = four_bar_linkage_outputs;
+  return k;
+}
 
 TEST(FourBarLinkage, EquilibriumAndFrequencyMatchTheMinimalCoordinateDerivation) {
-  const mbsgen::ModelKernels k = LOOP_KERNELS(four_bar_linkage);
+  const mbsgen::ModelKernels k = four_bar_kernels();
   mbsgen::GeneratedModel model(k);
   const mbsgen::OperatingPoint op = model.operating_point();
   ASSERT_TRUE(op.equilibrium);
@@ -46,6 +58,55 @@ TEST(FourBarLinkage, EquilibriumAndFrequencyMatchTheMinimalCoordinateDerivation)
   EXPECT_NEAR(omega2 / kOmega2, 1, 1e-12);
   // The geometric stiffness of the loaded loop is a third of the answer here.
   EXPECT_GT(std::abs(kOmega2Wrong / omega2 - 1), 0.4);
+}
+
+// The static loads at the cut pin (the multipliers) and at the crank's pivot (a joint probe less
+// the pin's share) against the statics of the rocker and coupler by hand.
+TEST(FourBarLinkage, StaticLoadsMatchTheStaticsOfTheBars) {
+  const mbsgen::ModelKernels k = four_bar_kernels();
+  mbsgen::GeneratedModel model(k);
+  const Eigen::VectorXd z = model.outputs(model.operating_point());
+  ASSERT_EQ(z.size(), 4);
+  // 1e-12 N of loads of ~3 N: the equilibrium angle known to ~1e-15, a few roundings.
+  EXPECT_NEAR(z[0], kPin[0], 1e-12);
+  EXPECT_NEAR(z[1], kPin[1], 1e-12);
+  EXPECT_NEAR(z[2], kPivot[0], 1e-12);
+  EXPECT_NEAR(z[3], kPivot[1], 1e-12);
+}
+
+// The frequency response of a load per crank torque against one built from finite differences
+// of the nonlinear `outputs_general` kernel (C_y, C_a, D) and a direct complex solve of the
+// reduced matrices: ẑ = (C_y − Ω² C_a) ŷ + D û.
+TEST(FourBarLinkage, LoadTransferMatchesDifferencesOfTheNonlinearLoad) {
+  const mbsgen::ModelKernels k = four_bar_kernels();
+  mbsgen::GeneratedModel model(k);
+  const mbsgen::OperatingPoint op = model.operating_point();
+  const mbsgen::LinearModel lin = model.linear_model(op);
+  const double* p = model.parameters().data();
+  auto load = [&](double y, double ydd, double u) {
+    double z[4], yd = 0;
+    EXPECT_EQ(four_bar_linkage_outputs_general(&y, &yd, &ydd, &u, p, z), 0);
+    return Eigen::Vector4d(z[0], z[1], z[2], z[3]);
+  };
+  const double y0 = op.y0[0], h = 1e-6;
+  // Central differences in y (truncation ~h², rounding ~1e-16/h of loads ~3 N: ~1e-10); ÿ and u
+  // enter linearly, so a unit step is exact to rounding.
+  const Eigen::Vector4d Cy = (load(y0 + h, 0, 0) - load(y0 - h, 0, 0)) / (2 * h);
+  const Eigen::Vector4d Ca = load(y0, 1, 0) - load(y0, 0, 0), D = load(y0, 0, 1) - load(y0, 0, 0);
+  mbsgen::FrequencyResponse frf(lin);
+  Eigen::VectorXd omega(4);
+  omega << 0.0, 3.0, 10.0, 30.0;  // around ω_n = 10.7 rad/s
+  for (Eigen::Index row = 0; row < 4; ++row) {
+    frf.compute(omega, 0, {row});
+    for (Eigen::Index i = 0; i < omega.size(); ++i) {
+      const double w = omega[i];
+      const double q = lin.has_damping() ? lin.Q()(0, 0) : 0.0;  // Q is stored empty when zero
+      const std::complex<double> yhat = lin.B()(0, 0) / std::complex<double>(lin.K()(0, 0) - w * w * lin.M()(0, 0), w * q);
+      const std::complex<double> expected = (Cy[row] - w * w * Ca[row]) * yhat + D[row];
+      EXPECT_LE(std::abs(frf.response()(0, i) - expected), 1e-7 * std::max(1.0, std::abs(expected)))
+          << k.output_names[row] << " at " << w << " rad/s";
+    }
+  }
 }
 
 // The loops close at every call: Φ(y) = 0 after assemble, from the operating point and from an
@@ -68,7 +129,7 @@ TEST(FourBarLinkage, AssembleClosesTheLoop) {
 // A coupler too short to span the gap (0.05 m where the crank's tip is at least 0.3 m from the
 // rocker's tip's circle): assemble returns 2, and the runtime names the failure.
 TEST(FourBarLinkage, LoopThatCannotCloseIsReported) {
-  const mbsgen::ModelKernels k = LOOP_KERNELS(four_bar_linkage);
+  const mbsgen::ModelKernels k = four_bar_kernels();
   mbsgen::GeneratedModel model(k);
   model.set("l2", 0.05);
   std::vector<double> yi(four_bar_linkage_n_coordinates), yd(yi.size()), y(four_bar_linkage_n_tree_coordinates);

@@ -83,3 +83,30 @@ print("th2 =", mp.nstr(y0[1], 25), " th3 =", mp.nstr(y0[2], 25))
 print("M =", mp.nstr(M0, 25), " K =", mp.nstr(K0, 25))
 print("omega^2 =", mp.nstr(K0 / M0, 25), " f [Hz] =", mp.nstr(sqrt(K0 / M0) / (2 * pi), 25))
 print("without geometric stiffness: omega^2 =", mp.nstr(K_wrong / M0, 25))
+
+# The pin's load on the rocker at the equilibrium, by statics of two bodies (no multipliers):
+# the rocker turns about D, the coupler about A; the unknown F acts on the rocker at B and -F on
+# the coupler at B; the spring pulls the coupler's middle towards P.
+(Ax, Ay), (Bx, By) = closed(theta0)
+c2 = ((Ax + Bx) / 2, (Ay + By) / 2)
+c3 = ((a + Bx) / 2, By / 2)
+dist = sqrt((c2[0] - P[0]) ** 2 + (c2[1] - P[1]) ** 2)
+Fs = (-k * (dist - L0) * (c2[0] - P[0]) / dist, -k * (dist - L0) * (c2[1] - P[1]) / dist)
+W = -m * g
+# rocker, moments about D: (B - D) x F + (c3 - D) x (0, W) = 0
+# coupler, moments about A: (B - A) x (-F) + (c2 - A) x (Fs + (0, W)) = 0
+cross = lambda r, f: r[0] * f[1] - r[1] * f[0]
+rB_D, rB_A = (Bx - a, By), (Bx - Ax, By - Ay)
+rhs1 = -cross((c3[0] - a, c3[1]), (0, W))
+rhs2 = cross((c2[0] - Ax, c2[1] - Ay), (Fs[0], Fs[1] + W))
+# [[-rB_D.y, rB_D.x], [-rB_A.y, rB_A.x]] F = [rhs1, rhs2]
+det = -rB_D[1] * rB_A[0] + rB_D[0] * rB_A[1]
+Fx = (rhs1 * rB_A[0] - rB_D[0] * rhs2) / det
+Fy = (-rB_D[1] * rhs2 + rB_A[1] * rhs1) / det
+print("pin load on the rocker: Fx =", mp.nstr(Fx, 25), " Fy =", mp.nstr(Fy, 25))
+# The world's load on the crank at O: the crank's weight, and -(the coupler's load on the crank)...
+# the whole linkage less the rocker: F_O + F_D + W*3 + Fs = 0 with F_D from the rocker:
+# rocker: F_D + F + (0, W) = 0.
+FDx, FDy = -Fx, -Fy - W
+FOx, FOy = -(FDx + Fs[0]), -(FDy + Fs[1] + 3 * W)
+print("pivot load on the crank: Fx =", mp.nstr(FOx, 25), " Fy =", mp.nstr(FOy, 25))

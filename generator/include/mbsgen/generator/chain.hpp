@@ -23,6 +23,8 @@ Model spatial_chain(int n);
 /// l3 = 0.25 m, uniform bars of 0.3 kg): crank (th1) and rocker (th3) pivoted on the world, the
 /// coupler (th2, relative to the crank) joined to the rocker's tip by the revolute constraint
 /// `pin`; gravity −y and a spring from a world anchor to the coupler's middle load the loop.
+/// Input: a torque T on the crank. Outputs: the pin's load on the rocker (pin_fx, pin_fy) and the
+/// world's load on the crank at its pivot (pivot_fx, pivot_fy), type reaction.
 /// Operating point: the equilibrium near th1 = 1 rad (guess closed elbow up).
 Model four_bar_linkage();
 
