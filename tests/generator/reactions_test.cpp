@@ -184,3 +184,130 @@ TEST(Reactions, RodOfTheCartesianPendulumHoldsTheBob) {
 }
 
 }  // namespace
+
+namespace {
+
+// A block on a frictionless guide inclined at α in the x–y plane: a free planar body (x, y, θ)
+// held by a prismatic constraint whose axis z_a is along the guide; a spring along the guide from
+// an anchor on it, gravity −y. One degree of freedom: ω² = k/m (the transverse stiffness of the
+// spring's preload acts against the constraint), and the guide's load on the block is the normal
+// force m g cos α along the guide's upward normal (−sin α, cos α).
+TEST(Reactions, BlockOnAnInclinedGuide) {
+  const double alpha = 0.5, mass = 2.0, k = 300.0, g = 9.81, L0 = 0.2;
+  Model m("incline");
+  m.add_parameter("g", g);
+  const ex x = m.add_coordinate("x").position, y = m.add_coordinate("y").position, th = m.add_coordinate("th").position;
+  Body b;
+  b.name = "block";
+  b.translation = {x, y, 0};
+  b.rotations = {{Axis::z, th}};
+  b.mass = mass;
+  b.inertia[0][0] = b.inertia[1][1] = b.inertia[2][2] = 0.01;
+  m.add_body(b);
+  const std::vector<ElementaryRotation> along = {{Axis::z, alpha}, {Axis::y, GiNaC::Pi / 2}};  // z_a = (cos α, sin α, 0)
+  Marker guide;
+  guide.name = "guide";
+  guide.body = kWorld;
+  Marker on_block = guide;
+  on_block.name = "on_block";
+  on_block.body = "block";
+  for (Marker* mk : {&guide, &on_block}) {
+    Mat3 R = identity_mat3();
+    for (const auto& r : along) {
+      Mat3 E = identity_mat3();
+      const int i = r.axis == Axis::z ? 0 : 2, j = r.axis == Axis::z ? 1 : 0;
+      E[i][i] = E[j][j] = GiNaC::cos(r.angle);
+      E[i][j] = -GiNaC::sin(r.angle);
+      E[j][i] = GiNaC::sin(r.angle);
+      R = mul(R, E);
+    }
+    mk->rotation = R;
+    m.add_marker(*mk);
+  }
+  Marker anchor;
+  anchor.name = "anchor";
+  anchor.body = kWorld;
+  anchor.position = {-std::cos(alpha), -std::sin(alpha), 0};  // 1 m down the guide
+  m.add_marker(anchor);
+  m.add_spring({"spring", "anchor", "on_block", k, L0, {}});
+  Gravity gr;
+  gr.g = {0, -g, 0};
+  m.add_gravity(gr);
+  Constraint c;
+  c.name = "slide";
+  c.kind = ConstraintKind::prismatic;
+  c.marker_a = "guide";
+  c.marker_b = "on_block";
+  m.add_constraint(c);
+  reaction(m, "normal_x", "slide", ForceQuantity::force, {1, 0, 0});
+  reaction(m, "normal_y", "slide", ForceQuantity::force, {0, 1, 0});
+  // Equilibrium along the guide: the compressed spring pushes up the slope, k (L0 − L) = m g sin α
+  // with L = 1 + s.
+  const double s = L0 - mass * g * std::sin(alpha) / k - 1.0;
+  OperatingPoint op;
+  op.position = {{"x", s * std::cos(alpha)}, {"y", s * std::sin(alpha)}, {"th", 0}};
+  m.set_operating_point(op);
+  Equations eq = derive(m);
+  ASSERT_EQ(eq.loops.equations.size(), 2u);  // y (transverse) and rx (turning); x, ry, rz vanish
+  LinearEquations lin = linearize(eq);
+  ASSERT_EQ(lin.M.size(), 1u);
+  GiNaC::exmap v;
+  for (const auto& p : m.parameters()) v[p.symbol] = p.value;
+  v[eq.y[0]] = s * std::cos(alpha), v[eq.y[1]] = s * std::sin(alpha), v[eq.y[2]] = 0;
+  auto num = [&](const ex& e) {
+    return GiNaC::ex_to<GiNaC::numeric>(GiNaC::evalf(eq.program.inline_all(e).subs(v))).to_double();
+  };
+  // 1e-12: the closed form against a double evaluation of the kernels' expressions.
+  EXPECT_NEAR(num(lin.K[0][0]) / num(lin.M[0][0]) / (k / mass), 1, 1e-12);
+  const std::map<std::string, double> at{{"x", s * std::cos(alpha)}, {"y", s * std::sin(alpha)}, {"th", 0}};
+  EXPECT_NEAR(output(eq, 0, at), -mass * g * std::cos(alpha) * std::sin(alpha), 1e-12);
+  EXPECT_NEAR(output(eq, 1, at), mass * g * std::cos(alpha) * std::cos(alpha), 1e-12);
+}
+
+// A point mass on three Cartesian coordinates held in the plane z = 0 by a planar constraint,
+// with springs along x and y and gravity −z: two modes sqrt(k_x/m), sqrt(k_y/m), and the plane
+// carries the weight.
+TEST(Reactions, PointOnAPlane) {
+  Model m("plane");
+  const ex x = m.add_coordinate("x").position, y = m.add_coordinate("y").position, z = m.add_coordinate("z").position;
+  Body b;
+  b.name = "bead";
+  b.translation = {x, y, z};
+  b.mass = 0.5;
+  m.add_body(b);
+  Marker floor;
+  floor.name = "floor";
+  floor.body = kWorld;
+  m.add_marker(floor);
+  Marker point;
+  point.name = "point";
+  point.body = "bead";
+  m.add_marker(point);
+  m.add_generalized_force({"spring_x", "x", -80 * x, {}, Category::springs});
+  m.add_generalized_force({"spring_y", "y", -20 * y, {}, Category::springs});
+  Gravity gr;
+  gr.g = {0, 0, -9.81};
+  m.add_gravity(gr);
+  Constraint c;
+  c.name = "plane";
+  c.kind = ConstraintKind::planar;
+  c.marker_a = "floor";
+  c.marker_b = "point";
+  m.add_constraint(c);
+  reaction(m, "normal", "plane", ForceQuantity::force, {0, 0, 1});
+  m.validate();
+  Equations eq = derive(m);
+  ASSERT_EQ(eq.loops.equations.size(), 1u);  // z; the bead cannot turn: rx, ry vanish
+  LinearEquations lin = linearize(eq);
+  ASSERT_EQ(lin.M.size(), 2u);
+  GiNaC::exmap v{{eq.y[0], 0}, {eq.y[1], 0}, {eq.y[2], 0}};
+  auto num = [&](const ex& e) {
+    return GiNaC::ex_to<GiNaC::numeric>(GiNaC::evalf(eq.program.inline_all(e).subs(v))).to_double();
+  };
+  EXPECT_EQ(num(lin.M[0][1]), 0);
+  EXPECT_NEAR(num(lin.K[0][0]) / num(lin.M[0][0]), 160, 1e-12);
+  EXPECT_NEAR(num(lin.K[1][1]) / num(lin.M[1][1]), 40, 1e-12);
+  EXPECT_NEAR(output(eq, 0, {{"x", 0}, {"y", 0}, {"z", 0}}), 0.5 * 9.81, 1e-13);
+}
+
+}  // namespace
