@@ -167,3 +167,84 @@ TEST(LoopClosure, LockedMechanismIsRefused) {
 }
 
 }  // namespace
+
+namespace {
+
+// A rigid body free in space (x, y, z and rotations a, b, c about x, y, z) hung from the world by
+// a spherical joint at its top: the physical pendulum about two axes and a free spin about the
+// vertical, ω² = m g d / (I + m d²); with a revolute joint about x instead, the swing about x only.
+Model hung_body(ConstraintKind kind) {
+  Model m("hung_body");
+  const double mass = 1.2, d = 0.4;
+  m.add_parameter("g", 9.81);
+  const ex x = m.add_coordinate("x").position, y = m.add_coordinate("y").position, z = m.add_coordinate("z").position;
+  const ex a = m.add_coordinate("a").position, b = m.add_coordinate("b").position, c = m.add_coordinate("c").position;
+  Body body;
+  body.name = "body";
+  body.translation = {x, y, z};
+  body.rotations = {{Axis::x, a}, {Axis::y, b}, {Axis::z, c}};
+  body.mass = mass;
+  body.com = {0, 0, -d};
+  body.inertia[0][0] = GiNaC::numeric(3, 100);
+  body.inertia[1][1] = GiNaC::numeric(2, 100);
+  body.inertia[2][2] = GiNaC::numeric(1, 100);
+  m.add_body(body);
+  Marker pivot, top;
+  pivot.name = "pivot";
+  pivot.body = kWorld;
+  top.name = "top";
+  top.body = "body";
+  if (kind == ConstraintKind::revolute) {  // the hinge axis z_a along x
+    Mat3 R = zero_mat3();
+    R[0][2] = 1, R[1][1] = 1, R[2][0] = -1;  // rotation by π/2 about y
+    pivot.rotation = top.rotation = R;
+  }
+  m.add_marker(pivot);
+  m.add_marker(top);
+  Gravity gr;
+  gr.g = {0, 0, -m.symbol("g")};
+  m.add_gravity(gr);
+  Constraint joint;
+  joint.name = "joint";
+  joint.kind = kind;
+  joint.marker_a = "pivot";
+  joint.marker_b = "top";
+  m.add_constraint(joint);
+  m.validate();
+  return m;
+}
+
+TEST(LoopClosure, SphericalJointMakesAPhysicalPendulumInSpace) {
+  Model m = hung_body(ConstraintKind::spherical);
+  Equations eq = derive(m);
+  ASSERT_EQ(eq.loops.equations.size(), 3u);
+  LinearEquations lin = linearize(eq);
+  ASSERT_EQ(lin.M.size(), 3u);
+  std::vector<std::string> names;
+  for (std::size_t k : lin.coordinates) names.push_back(m.coordinates()[k].name);
+  EXPECT_EQ(names, (std::vector<std::string>{"a", "b", "c"}));
+  const double mgd = 1.2 * 9.81 * 0.4, md2 = 1.2 * 0.16;
+  // At rest the swings and the spin decouple: M and K diagonal (exact zeros), ω² = K/M.
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t j = 0; j < 3; ++j)
+      if (i != j) {
+        EXPECT_EQ(value(eq, lin, lin.M[i][j]), 0) << i << j;
+      }
+  EXPECT_NEAR(value(eq, lin, lin.K[0][0]) / value(eq, lin, lin.M[0][0]) / (mgd / (0.03 + md2)), 1, 1e-14);
+  EXPECT_NEAR(value(eq, lin, lin.K[1][1]) / value(eq, lin, lin.M[1][1]) / (mgd / (0.02 + md2)), 1, 1e-14);
+  EXPECT_EQ(value(eq, lin, lin.K[2][2]), 0);  // the spin about the vertical: no stiffness
+  EXPECT_NEAR(value(eq, lin, lin.M[2][2]), 0.01, 1e-16);
+}
+
+TEST(LoopClosure, RevoluteJointInSpaceLeavesOneSwing) {
+  Model m = hung_body(ConstraintKind::revolute);
+  Equations eq = derive(m);
+  ASSERT_EQ(eq.loops.equations.size(), 5u);
+  LinearEquations lin = linearize(eq);
+  ASSERT_EQ(lin.M.size(), 1u);
+  EXPECT_EQ(m.coordinates()[lin.coordinates[0]].name, "a");
+  const double mgd = 1.2 * 9.81 * 0.4, md2 = 1.2 * 0.16;
+  EXPECT_NEAR(value(eq, lin, lin.K[0][0]) / value(eq, lin, lin.M[0][0]) / (mgd / (0.03 + md2)), 1, 1e-14);
+}
+
+}  // namespace
