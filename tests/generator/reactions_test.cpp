@@ -2,6 +2,8 @@
 // equilibrium against a Newton–Euler computation by hand, static loads that equal the weight
 // they carry, and the loads at the cut joints of closed loops.
 #include "mbsgen/generator/linearize.hpp"
+#include "mbsgen/generator/reactions.hpp"
+#include "mbsgen/generator/scene.hpp"
 
 #include "loop_models.hpp"
 
@@ -308,6 +310,28 @@ TEST(Reactions, PointOnAPlane) {
   EXPECT_NEAR(num(lin.K[0][0]) / num(lin.M[0][0]), 160, 1e-12);
   EXPECT_NEAR(num(lin.K[1][1]) / num(lin.M[1][1]), 40, 1e-12);
   EXPECT_NEAR(output(eq, 0, {{"x", 0}, {"y", 0}, {"z", 0}}), 0.5 * 9.81, 1e-13);
+}
+
+}  // namespace
+
+namespace {
+
+// A scene that asks for one joint load probes that joint only: the other reactions are pruned
+// with their outputs, and the load is the same as in the full model (at ẏ = 0: a scene about rest
+// drops the velocity-quadratic inertia terms, docs/scenes.md).
+TEST(Reactions, SceneProbesOnlyTheLoadsItAsksFor) {
+  Model m = double_pendulum();
+  Scene s;
+  s.name = "upper_load";
+  s.analyses = {Analysis::frf};
+  s.outputs = std::vector<SceneItem>{{"upper_fy", {}}};
+  m.add_scene(s);
+  const Model pruned = apply_scene(m, "upper_load");
+  EXPECT_EQ(probed_bodies(pruned), std::vector<std::string>{"upper"});
+  Equations full = derive(m), scene = derive(pruned);
+  ASSERT_EQ(scene.outputs.size(), 1u);
+  const std::map<std::string, double> y{{"q1", 0.3}, {"q2", 0.2}}, yd{}, ydd{{"q2", 1.5}};
+  EXPECT_NEAR(output(scene, 0, y, yd, ydd), output(full, 1, y, yd, ydd), 1e-13);
 }
 
 }  // namespace
