@@ -860,6 +860,8 @@ class Reader {
   void read_marker(const YAML::Node& n, const std::string& body, const YAML::Node* body_node);
   void read_force(const YAML::Node& n, std::map<std::string, int>& counters);
   void read_output(const YAML::Node& n);
+  void read_load_output(const YAML::Node& n, const std::string& type, const Fields& f, Output& o);
+  void read_constraint(const YAML::Node& n, std::map<std::string, int>& counters);
   void read_operating_point(const Entry& e);
   OperatingPointOverride read_operating_point_values(const YAML::Node& n, const std::string& what);
   void read_scene(const YAML::Node& n);
@@ -929,7 +931,8 @@ Model Reader::read_model() {
                                     "'model: NAME')");
   const Fields top = fields(root, "the model file",
                             {"model", "parameters", "coordinates", "inputs", "bodies", "markers",
-                             "forces", "outputs", "operating_point", "scenes"});
+                             "forces", "constraints", "independent_coordinates", "outputs",
+                             "operating_point", "scenes"});
 
   const Entry& name_entry = require(top, "model", root, "the model file");
   const std::string model_name = name(name_entry, "the model name");
@@ -963,12 +966,21 @@ Model Reader::read_model() {
   for (const auto& m : list(find(top, "markers"), "markers")) read_marker(m, "", nullptr);
 
   const std::vector<YAML::Node> forces = list(find(top, "forces"), "forces");
+  const std::vector<YAML::Node> constraints = list(find(top, "constraints"), "constraints");
   const std::vector<YAML::Node> outputs = list(find(top, "outputs"), "outputs");
-  for (const auto* group : {&forces, &outputs})
+  for (const auto* group : {&forces, &constraints, &outputs})
     for (const auto& n : *group)
       if (n.IsMap() && n["name"] && n["name"].IsScalar()) used_names_.insert(n["name"].Scalar());
   std::map<std::string, int> counters;
   for (const auto& f : forces) read_force(f, counters);
+  for (const auto& c : constraints) read_constraint(c, counters);
+  if (const Entry* e = find(top, "independent_coordinates")) {
+    std::vector<SceneItem> names = items(*e, "independent_coordinates");
+    for (const auto& item : names)
+      if (model.coordinate_index(item.name) < 0)
+        throw ModelError(item.where, "independent coordinate '" + item.name + "' is not a coordinate");
+    model.set_independent_coordinates(std::move(names));
+  }
   for (const auto& o : outputs) read_output(o);
 
   if (const Entry* op = find(top, "operating_point")) read_operating_point(*op);
@@ -1283,7 +1295,7 @@ void Reader::read_force(const YAML::Node& n, std::map<std::string, int>& counter
 
 void Reader::read_output(const YAML::Node& n) {
   static const std::vector<std::string> types = {"position", "velocity", "coordinate", "rate",
-                                                 "expression"};
+                                                 "expression", "reaction", "force"};
   if (!n.IsMap()) fail(n, "expected a map for an output, got " + describe(n));
   const YAML::Node type_node = n["type"];
   if (!type_node) fail(n, "an output needs the key 'type' (one of: " + join(types) + ")");
@@ -1297,6 +1309,8 @@ void Reader::read_output(const YAML::Node& n) {
   if (type == "position" || type == "velocity") keys.insert(keys.end(), {"marker", "direction"});
   if (type == "coordinate" || type == "rate") keys.insert(keys.end(), {"coordinate"});
   if (type == "expression") keys.insert(keys.end(), {"expression"});
+  if (type == "reaction") keys.insert(keys.end(), {"of", "quantity", "direction", "frame"});
+  if (type == "force") keys.insert(keys.end(), {"elements", "quantity", "direction", "frame"});
   const std::string what = "a " + type + " output";
   const Fields f = fields(n, what, keys);
   Output o;
@@ -1310,11 +1324,92 @@ void Reader::read_output(const YAML::Node& n) {
   } else if (type == "coordinate" || type == "rate") {
     o.kind = type == "coordinate" ? OutputKind::coordinate : OutputKind::rate;
     o.coordinate = check_coordinate(value(require(f, "coordinate", n, what)));
+  } else if (type == "reaction" || type == "force") {
+    read_load_output(n, type, f, o);
   } else {
     o.kind = OutputKind::expression;
     o.expression = expr(require(f, "expression", n, what), "an output expression", Scope::no_inputs);
   }
   model_->add_output(o);
+}
+
+// `type: reaction` (of: a body or a constraint) and `type: force` (elements: force elements),
+// with quantity force|torque and a direction in the world frame or a frame (reactions.hpp).
+void Reader::read_load_output(const YAML::Node& n, const std::string& type, const Fields& f, Output& o) {
+  const std::string what = "a " + type + " output";
+  if (const Entry* q = find(f, "quantity")) {
+    const std::string quantity = scalar(value(*q), "a quantity");
+    if (quantity != "force" && quantity != "torque")
+      fail(value(*q), "unknown quantity '" + quantity + "' (force or torque)");
+    o.quantity = quantity == "force" ? ForceQuantity::force : ForceQuantity::torque;
+  }
+  o.direction = vec3(require(f, "direction", n, what), "an output direction", Scope::parameters);
+  const Entry* frame = find(f, "frame");
+  const std::string frame_name = frame ? scalar(value(*frame), "a frame") : "world";
+  if (type == "reaction") {
+    o.kind = OutputKind::reaction;
+    o.reaction_of = name(require(f, "of", n, what), "a body or constraint name");
+    if (frame_name != "world") o.frame_marker = check_marker(value(*frame));
+    return;
+  }
+  o.kind = OutputKind::force;
+  const YAML::Node& list_node = value(require(f, "elements", n, what));
+  if (!list_node.IsSequence() || list_node.size() == 0)
+    fail(list_node, "'elements' needs a list of force element names, got " + describe(list_node));
+  for (const auto& element : list_node) o.elements.push_back(scalar(element, "a force element name"));
+  if (frame_name != "world" && frame_name != "marker")
+    fail(value(*frame), "a force output's frame is 'world' or 'marker' (marker b of its first element), got '" +
+                            frame_name + "'");
+  o.force_frame = frame_name == "world" ? ForceFrame::world : ForceFrame::marker;
+}
+
+// A loop-closure constraint (model.hpp, Constraint): a joint between two markers, a rod of a
+// length, or an expression Φ(y) = 0.
+void Reader::read_constraint(const YAML::Node& n, std::map<std::string, int>& counters) {
+  static const std::vector<std::string> types = {"spherical", "revolute", "prismatic", "planar", "distance",
+                                                 "expression"};
+  if (!n.IsMap()) fail(n, "expected a map for a constraint, got " + describe(n));
+  const YAML::Node type_node = n["type"];
+  if (!type_node) fail(n, "a constraint needs the key 'type' (one of: " + join(types) + ")");
+  const std::string type = scalar(type_node, "a constraint type");
+  if (std::find(types.begin(), types.end(), type) == types.end()) {
+    std::string hint = suggestion(type, types);
+    fail(type_node, "unknown constraint type '" + type + "'" + (hint.empty() ? " (one of: " + join(types) + ")" : hint));
+  }
+  std::vector<std::string> keys = {"type", "name"};
+  if (type == "expression") keys.push_back("expression");
+  else keys.push_back("between");
+  if (type == "distance") keys.push_back("length");
+  const std::string what = "a " + type + " constraint";
+  const Fields f = fields(n, what, keys);
+  Constraint c;
+  if (const Entry* e = find(f, "name")) {
+    c.name = name(*e, "a constraint name");
+  } else {
+    int& k = counters[type];
+    do c.name = type + std::to_string(++k);
+    while (used_names_.count(c.name));
+  }
+  used_names_.insert(c.name);
+  c.where = element_loc(n);
+  static const std::map<std::string, ConstraintKind> kinds = {
+      {"spherical", ConstraintKind::spherical}, {"revolute", ConstraintKind::revolute},
+      {"prismatic", ConstraintKind::prismatic}, {"planar", ConstraintKind::planar},
+      {"distance", ConstraintKind::distance},   {"expression", ConstraintKind::expression}};
+  c.kind = kinds.at(type);
+  if (type == "expression") {
+    c.expression = expr(require(f, "expression", n, what), "a constraint expression", Scope::positions);
+  } else {
+    const YAML::Node& bn = value(require(f, "between", n, what));
+    if (!bn.IsSequence() || bn.size() != 2)
+      fail(bn, "'between' needs a list of two marker names [A, B], got " +
+                   (bn.IsSequence() ? std::to_string(bn.size()) + " entries" : describe(bn)));
+    c.marker_a = check_marker(bn[0]);
+    c.marker_b = check_marker(bn[1]);
+    if (c.marker_a == c.marker_b) fail(bn[1], "a " + type + " constraint between marker '" + c.marker_a + "' and itself");
+  }
+  if (type == "distance") c.length = expr(require(f, "length", n, what), "a rod length", Scope::parameters);
+  model_->add_constraint(c);
 }
 
 void Reader::read_operating_point(const Entry& e) {
