@@ -217,8 +217,9 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
       case OutputKind::expression:
         eq.outputs.push_back(o.expression);
         break;
-      case OutputKind::force:  // element forces: being built (issue 15)
-        throw ModelError(o.where, "output '" + o.name + "': force outputs are not derived yet");
+      case OutputKind::force:
+        eq.outputs.push_back(force_output(model, eq, o));
+        break;
       case OutputKind::reaction:  // reaction_outputs (reactions.hpp) writes it
         eq.outputs.push_back(0);
         break;

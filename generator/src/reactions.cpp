@@ -228,6 +228,81 @@ Load joint_load(const Model& model, Equations& eq, const JointProbes& probes, st
 
 }  // namespace
 
+namespace {
+
+// The load of one force element on the body of its marker b (world frame; torque about b's point).
+Load element_load(const Model& model, Equations& eq, const std::string& name) {
+  Program& prog = eq.program;
+  const Kinematics& kin = eq.kinematics;
+  auto between = [&](const std::string& a, const std::string& b) {
+    return define(prog, sub(kin.marker_position(model, prog, b), kin.marker_position(model, prog, a)));
+  };
+  Load load;
+  for (const auto& s : model.springs())
+    if (s.name == name) {
+      const Vec3 d = between(s.marker_a, s.marker_b);
+      const ex L = prog.define(GiNaC::sqrt(dot(d, d)));
+      load.force = s.rest_length.is_zero() ? scale(-s.stiffness, d)
+                                           : scale(prog.define(-s.stiffness * (L - s.rest_length) / L), d);
+    }
+  for (const auto& c : model.dampers())
+    if (c.name == name) {
+      const Vec3 d = between(c.marker_a, c.marker_b);
+      const Vec3 dd = define(prog, sub(kin.marker_velocity(model, prog, c.marker_b), kin.marker_velocity(model, prog, c.marker_a)));
+      load.force = scale(prog.define(-c.damping * dot(d, dd) / dot(d, d)), d);
+    }
+  for (const auto& b : model.bushings())
+    if (b.name == name) {
+      const Mat3 Sa = kin.marker_frame(model, prog, b.marker_a), Sb = kin.marker_frame(model, prog, b.marker_b);
+      const Vec3 d = between(b.marker_a, b.marker_b);
+      const Vec3 dr = define(prog, mul_transposed(Sa, d));
+      const Mat3 R = define(prog, mul(transpose(Sa), Sb));
+      const Vec3 theta = define(prog, Vec3{(R[2][1] - R[1][2]) / 2, (R[0][2] - R[2][0]) / 2, (R[1][0] - R[0][1]) / 2});
+      const Vec3 wa = kin.marker_angular_velocity(model, b.marker_a), wb = kin.marker_angular_velocity(model, b.marker_b);
+      const Vec3 drdot = define(prog, mul_transposed(Sa, sub(sub(kin.marker_velocity(model, prog, b.marker_b),
+                                                                 kin.marker_velocity(model, prog, b.marker_a)),
+                                                             cross(wa, d))));
+      const Vec3 wrel = define(prog, mul_transposed(Sa, sub(wb, wa)));
+      Vec3 f = zero_vec3(), kr = zero_vec3(), dr_w = zero_vec3();
+      for (std::size_t i = 0; i < 3; ++i) {
+        f[i] = b.k_translation[i] * dr[i] + b.d_translation[i] * drdot[i];
+        kr[i] = b.k_rotation[i] * theta[i];
+        dr_w[i] = b.d_rotation[i] * wrel[i];
+      }
+      // ∂θ/∂φ_b = ½ (tr R·E − R) S_aᵀ: the torque is its transpose on K_r θ.
+      const ex trace = R[0][0] + R[1][1] + R[2][2];
+      Vec3 t = zero_vec3();
+      for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) t[i] += ((i == j ? trace : ex(0)) - R[j][i]) * kr[j] / 2;
+      load.force = scale(-1, mul(Sa, f));
+      load.torque = scale(-1, mul(Sa, add(t, dr_w)));
+    }
+  return load;
+}
+
+std::string marker_b_of(const Model& model, const std::string& element) {
+  for (const auto& s : model.springs())
+    if (s.name == element) return s.marker_b;
+  for (const auto& d : model.dampers())
+    if (d.name == element) return d.marker_b;
+  for (const auto& b : model.bushings())
+    if (b.name == element) return b.marker_b;
+  return "";
+}
+
+}  // namespace
+
+ex force_output(const Model& model, Equations& eq, const Output& o) {
+  Vec3 v = zero_vec3();
+  for (const auto& name : o.elements) {
+    const Load load = element_load(model, eq, name);
+    v = add(v, o.quantity == ForceQuantity::force ? load.force : load.torque);
+  }
+  if (o.force_frame == ForceFrame::marker && !o.elements.empty())
+    v = mul_transposed(eq.kinematics.marker_frame(model, eq.program, marker_b_of(model, o.elements.front())), v);
+  return eq.program.define(dot(o.direction, v));
+}
+
 void reaction_outputs(Equations& eq, JointProbes& probes) {
   const Model& model = *eq.model;
   Program& prog = eq.program;

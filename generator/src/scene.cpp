@@ -373,6 +373,20 @@ Model apply_scene(const Model& model, const std::string& name) {
       if (o.name == n) m.outputs_.push_back(o);
   for (const auto& o : model.outputs())
     if (std::find(outputs.begin(), outputs.end(), o.name) == outputs.end()) remove_name(o.name);
+  // A force output sums the elements the scene keeps; with none left it is 0.
+  for (Output& o : m.outputs_) {
+    if (o.kind != OutputKind::force) continue;
+    std::vector<std::string> kept;
+    for (const auto& e : o.elements) {
+      bool present = false;
+      for (const auto& x : m.springs_) present = present || x.name == e;
+      for (const auto& x : m.dampers_) present = present || x.name == e;
+      for (const auto& x : m.bushings_) present = present || x.name == e;
+      if (present) kept.push_back(e);
+    }
+    o.elements = kept;
+    if (kept.empty()) o.kind = OutputKind::expression, o.expression = 0;
+  }
   return m;
 }
 

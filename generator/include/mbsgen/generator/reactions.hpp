@@ -51,4 +51,16 @@ void strip_joint_probes(const Model& model, Equations& eq, JointProbes& probes);
 /// eq.ydd) and u, written into eq.outputs (tree form, before reduce_equations).
 void reaction_outputs(Equations& eq, JointProbes& probes);
 
+/// The value z(y, ẏ) of an output of type force (model.hpp, Output::elements): the force, or the
+/// torque about marker b's point, that the named springs, dampers and bushings exert on the body
+/// of their marker b, summed, against the direction in the world frame (or in marker b's frame of
+/// the first element). The loads are the gradients of the elements' potential and dissipation
+/// with respect to a displacement and a small rotation of marker b, so that their virtual work
+/// is the generalized force the element puts on the coordinates (dynamics.hpp):
+///   spring   F_b = −k (L − L0) d/L            (d = r_b − r_a, L = |d|; −k d when L0 = 0)
+///   damper   F_b = −c (d·ḋ) d/L²
+///   bushing  F_b = −S_a (K_t Δr + D_t Δṙ),  τ_b = −S_a (½ (tr R·E − Rᵀ) K_r θ + D_r ω_rel)
+///            with R = S_aᵀ S_b, θ = vee(skew R) (model.hpp, Bushing).
+GiNaC::ex force_output(const Model& model, Equations& eq, const Output& output);
+
 }  // namespace mbsgen
