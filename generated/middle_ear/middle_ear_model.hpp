@@ -109,11 +109,11 @@ enum class Coordinate : int { malleus_x = 0, malleus_y = 1, malleus_z = 2, malle
 /// Inputs, as columns of B.
 enum class Input : int { P = 0 };
 /// Outputs, as rows of C_y and C_v.
-enum class Output : int { v_stapes = 0, v_umbo = 1, v_incus_isj = 2, x_stapes = 3, x_umbo = 4, v_stapes_y = 5, omega_malleus_x = 6, omega_stapes_x = 7, omega_stapes_y = 8 };
+enum class Output : int { v_stapes = 0, v_umbo = 1, v_incus_isj = 2, x_stapes = 3, x_umbo = 4, v_stapes_y = 5, omega_malleus_x = 6, omega_stapes_x = 7, omega_stapes_y = 8, F_cochlea = 9 };
 
 inline constexpr int n_coordinates = 18;
 inline constexpr int n_inputs = 1;
-inline constexpr int n_outputs = 9;
+inline constexpr int n_outputs = 10;
 inline constexpr int n_parameters = 87;
 
 /// The kernels, names and defaults, for mbsgen::GeneratedModel and the solver command line.

@@ -213,6 +213,10 @@ Assembly assemble(const Parameters& p) {
   point_output("x_stapes", A.Cy, A.Cy_scale, kStapes, vec(p, "fp"), medial);
   point_output("x_umbo", A.Cy, A.Cy_scale, kMalleus, vec(p, "umbo"), medial);
   point_output("v_stapes_y", A.Cv, A.Cv_scale, kStapes, vec(p, "fp"), superior);
+  // F_cochlea: minus the annular ligament's load on the footplate along z, the world-fixed
+  // bushing's k_z Δz + d_z Δż (d_z with the cochlear load), = k_z x_stapes + d_z v_stapes medial.
+  point_output("F_cochlea", A.Cy, A.Cy_scale, kStapes, vec(p, "fp"), medial * p.at("k_al_z"));
+  point_output("F_cochlea", A.Cv, A.Cv_scale, kStapes, vec(p, "fp"), medial * (p.at("d_al_z") + p.at("d_cochlea_z")));
   for (const auto& [output, coordinate] :
        {std::pair<std::string, std::string>{"omega_malleus_x", "malleus_rx"},
         {"omega_stapes_x", "stapes_rx"},
