@@ -2,8 +2,10 @@
 // loaded four-bar's equilibrium found by Newton's method on the reduced statics, and its
 // frequency, against an independent derivation in one minimal coordinate
 // (tests/reference/four_bar_linkage_reference.py, mpmath at 50 digits).
+#include "four_bar.hpp"
 #include "four_bar_linkage.hpp"
 #include "ladder_3.hpp"
+#include "slider_crank.hpp"
 
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/generated_model.hpp"
@@ -157,6 +159,48 @@ TEST(Ladder, HangingLadderIsAStableEquilibrium) {
   const mbsgen::LinearModel lin = model.linear_model(op);
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(lin.K(), lin.M());
   EXPECT_GT(es.eigenvalues().minCoeff(), 0);
+}
+
+// models/linkages/four_bar.yaml is the same linkage as the C++ API's four_bar_linkage, with the
+// crank listed as the independent coordinate: the same equilibrium, frequency and loads.
+TEST(FourBarYaml, MatchesTheReference) {
+  mbsgen::ModelKernels k = LOOP_KERNELS(four_bar);
+  k.output_terms = four_bar_output_terms;
+  k.outputs = four_bar_outputs;
+  mbsgen::GeneratedModel model(k);
+  EXPECT_STREQ(four_bar_coordinate_names[0], "th1");
+  const mbsgen::OperatingPoint op = model.operating_point();
+  EXPECT_NEAR(op.y0[0], kTheta0, 1e-13);
+  const mbsgen::LinearModel lin = model.linear_model(op);
+  EXPECT_NEAR(lin.K()(0, 0) / lin.M()(0, 0) / kOmega2, 1, 1e-12);
+  const Eigen::VectorXd z = model.outputs(op);
+  EXPECT_NEAR(z[0], kPin[0], 1e-12);
+  EXPECT_NEAR(z[1], kPin[1], 1e-12);
+  EXPECT_NEAR(z[2], kPivot[0], 1e-12);
+  EXPECT_NEAR(z[3], kPivot[1], 1e-12);
+  EXPECT_NEAR(z[4], kTheta0, 1e-13);
+}
+
+// models/linkages/slider_crank.yaml against tests/reference/slider_crank_reference.py: the
+// equilibrium, the frequency and the load at every joint (statics of each body by hand).
+TEST(SliderCrank, EquilibriumFrequencyAndEveryJointLoad) {
+  mbsgen::ModelKernels k = LOOP_KERNELS(slider_crank);
+  k.outputs = slider_crank_outputs;
+  mbsgen::GeneratedModel model(k);
+  const mbsgen::OperatingPoint op = model.operating_point();
+  std::vector<double> y(slider_crank_n_tree_coordinates);
+  ASSERT_EQ(slider_crank_assemble(op.y0.data(), model.parameters().data(), y.data()), 0);
+  EXPECT_NEAR(y[0], -1.237847263651808002856276, 1e-13);
+  EXPECT_NEAR(y[1], 1.558332930743535407287844, 1e-13);
+  EXPECT_NEAR(y[2], 0.3174079148399754307166147, 1e-14);
+  const mbsgen::LinearModel lin = model.linear_model(op);
+  EXPECT_NEAR(lin.K()(0, 0) / lin.M()(0, 0) / 32.69465570242052536678955, 1, 1e-12);
+  const Eigen::VectorXd z = model.outputs(op);
+  const double expected[9] = {-0.91296042580012284642, -2.2650375797343765187, 0, 7.1700375797343765187,
+                              -0.91296042580012284642, 1.6589624202656234813, -0.91296042580012284642,
+                              3.6209624202656234813, 0.91296042580012284642};
+  // Loads of a few N: 1e-12 N is rounding through the loop's elimination.
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(z[i], expected[i], 1e-12) << slider_crank_output_names[i];
 }
 
 }  // namespace
