@@ -275,9 +275,9 @@ void choose_coordinates(const Model& model, const MatrixXd& J, LoopClosure& loop
     std::set<std::size_t> indep;
     for (const auto& item : listed) indep.insert(static_cast<std::size_t>(model.coordinate_index(item.name)));
     if (indep.size() != n - m)
-      throw ModelError(listed.front().where, "the constraints leave " + std::to_string(n - m) +
-                                                 " independent coordinates; " + std::to_string(indep.size()) +
-                                                 " are listed");
+      throw ModelError(listed.front().where, "the constraints leave " + std::to_string(n - m) + " independent coordinate" +
+                                                 (n - m == 1 ? "" : "s") + "; " + std::to_string(indep.size()) +
+                                                 (indep.size() == 1 ? " is" : " are") + " listed");
     dependent.clear();
     for (std::size_t j = 0; j < n; ++j)
       if (!indep.count(j)) dependent.push_back(j);

@@ -560,3 +560,85 @@ TEST(Yaml, AnAliasThatDuplicatesNothingIsFine) {
 }  // namespace issue14
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Closed loops and loads (issue 15)
+
+TEST(Linkages, ContentsAsWritten) {
+  const mbsgen::Model m = mbsgen::read_model_file(kSourceDir + "/models/linkages/slider_crank.yaml");
+  ASSERT_EQ(m.constraints().size(), 1u);
+  const mbsgen::Constraint& pin = m.constraints()[0];
+  EXPECT_EQ(pin.name, "pin");
+  EXPECT_EQ(pin.kind, mbsgen::ConstraintKind::revolute);
+  EXPECT_EQ(pin.marker_a, "rod_end");
+  EXPECT_EQ(pin.marker_b, "slider_pin");
+  EXPECT_GT(pin.where.line, 0);
+  ASSERT_EQ(m.independent_coordinates().size(), 1u);
+  EXPECT_EQ(m.independent_coordinates()[0].name, "th1");
+  const mbsgen::Output& guide = m.outputs()[3];
+  EXPECT_EQ(guide.kind, mbsgen::OutputKind::reaction);
+  EXPECT_EQ(guide.reaction_of, "slider");
+  EXPECT_EQ(guide.quantity, mbsgen::ForceQuantity::force);
+  EXPECT_TRUE(guide.frame_marker.empty());
+  EXPECT_TRUE((guide.direction[1] - 1).is_zero());
+  const mbsgen::Output& spring = m.outputs()[8];
+  EXPECT_EQ(spring.kind, mbsgen::OutputKind::force);
+  EXPECT_EQ(spring.elements, std::vector<std::string>{"spring"});
+}
+
+TEST(Linkages, DefaultNamesKindsAndFrames) {
+  const mbsgen::Model m = mbsgen::read_model_string(R"(model: loops
+parameters: {L: 0.5}
+coordinates: [x, y, z]
+bodies:
+  - {name: bob, translation: [x, y, z], mass: 1, markers: [{name: p}]}
+markers: [{name: o}]
+forces:
+  - {name: holder, type: spring, between: [o, p], stiffness: 10}
+constraints:
+  - {type: distance, between: [o, p], length: L}
+  - {type: expression, expression: z}
+  - {type: planar, between: [o, p]}
+outputs:
+  - {name: t, type: reaction, of: distance1, quantity: torque, direction: [0, 0, 1], frame: p}
+  - {name: f, type: force, elements: [holder], direction: [1, 0, 0], frame: marker, quantity: torque}
+operating_point: {position: {y: -L}}
+)", "loops.yaml");
+  ASSERT_EQ(m.constraints().size(), 3u);
+  EXPECT_EQ(m.constraints()[0].name, "distance1");
+  EXPECT_TRUE((m.constraints()[0].length - m.symbol("L")).is_zero());
+  EXPECT_EQ(m.constraints()[1].name, "expression1");
+  EXPECT_EQ(m.constraints()[1].kind, mbsgen::ConstraintKind::expression);
+  EXPECT_TRUE((m.constraints()[1].expression - m.symbol("z")).is_zero());
+  EXPECT_EQ(m.constraints()[2].name, "planar1");
+  EXPECT_EQ(m.outputs()[0].quantity, mbsgen::ForceQuantity::torque);
+  EXPECT_EQ(m.outputs()[0].frame_marker, "p");
+  EXPECT_EQ(m.outputs()[1].force_frame, mbsgen::ForceFrame::marker);
+}
+
+// The complete four-bar of docs/model-format.md reads, derives and closes its loop, and is the
+// model file models/linkages/four_bar.yaml up to its comments and outputs.
+TEST(Linkages, DocumentationFourBarReads) {
+  std::ifstream in(kSourceDir + "/docs/model-format.md");
+  std::string line, yaml;
+  bool after = false, inside = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("A complete four-bar", 0) == 0) after = true;
+    if (after && !inside && line == "```yaml") {
+      inside = true;
+      continue;
+    }
+    if (inside && line == "```") break;
+    if (inside) yaml += line + "\n";
+  }
+  ASSERT_FALSE(yaml.empty());
+  const mbsgen::Model m = mbsgen::read_model_string(yaml, "model-format.md");
+  mbsgen::Equations eq = mbsgen::derive(m);
+  EXPECT_EQ(eq.loops.equations.size(), 2u);
+  ASSERT_EQ(eq.loops.independent.size(), 1u);
+  EXPECT_EQ(m.coordinates()[eq.loops.independent[0]].name, "th1");
+  const mbsgen::Model file = mbsgen::read_model_file(kSourceDir + "/models/linkages/four_bar.yaml");
+  ASSERT_EQ(m.parameters().size(), file.parameters().size());
+  for (std::size_t i = 0; i < m.parameters().size(); ++i)
+    EXPECT_EQ(m.parameters()[i].value, file.parameters()[i].value) << m.parameters()[i].name;
+}
