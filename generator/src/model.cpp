@@ -371,6 +371,24 @@ std::string inertia_problem(const Mat3& I, const GiNaC::exmap& defaults, const G
 
 }  // namespace
 
+// The names of the parameters, and with `coordinates` also of the coordinates.
+std::set<std::string> Model::symbol_names(bool coordinates) const {
+  std::set<std::string> names;
+  for (const auto& p : parameters_) names.insert(p.name);
+  if (coordinates)
+    for (const auto& c : coordinates_) names.insert(c.name);
+  return names;
+}
+
+// A ModelError at `where` when e uses a symbol outside `allowed`.
+void Model::check_symbols(const GiNaC::ex& e, const SourceLocation& where, const std::string& what,
+                          const std::set<std::string>& allowed) {
+  std::set<std::string> syms;
+  collect_symbols(e, syms);
+  for (const auto& s : syms)
+    if (!allowed.count(s)) throw ModelError(where, what + " may not depend on '" + s + "'");
+}
+
 // A force output names force elements that transmit a force between two markers.
 void Model::validate_force_output(const Output& o) const {
   if (o.elements.empty())
@@ -394,16 +412,7 @@ void Model::validate_force_output(const Output& o) const {
 // once each; and the operating point is at rest (steady motions of closed loops are not
 // linearized: see loop_closure.hpp).
 void Model::validate_constraints(const GiNaC::exmap& defaults) const {
-  std::set<std::string> position_only, parameters_only;
-  for (const auto& p : parameters_) position_only.insert(p.name), parameters_only.insert(p.name);
-  for (const auto& c : coordinates_) position_only.insert(c.name);
-  auto check_symbols = [&](const GiNaC::ex& e, const SourceLocation& where, const std::string& what,
-                           const std::set<std::string>& allowed) {
-    std::set<std::string> syms;
-    collect_symbols(e, syms);
-    for (const auto& s : syms)
-      if (!allowed.count(s)) throw ModelError(where, what + " may not depend on '" + s + "'");
-  };
+  const std::set<std::string> position_only = symbol_names(true), parameters_only = symbol_names(false);
   for (const auto& c : constraints_) {
     const std::string who = std::string(to_string(c.kind)) + " constraint '" + c.name + "'";
     if (c.kind == ConstraintKind::expression) {
@@ -448,20 +457,9 @@ void Model::validate_constraints(const GiNaC::exmap& defaults) const {
 void Model::validate() const {
   std::set<std::string> known;
   for (const auto& [name, sym] : symtab_) known.insert(name);
-  std::set<std::string> position_only;  // parameters and coordinates (no rates, no inputs)
-  for (const auto& p : parameters_) position_only.insert(p.name);
-  for (const auto& c : coordinates_) position_only.insert(c.name);
-  std::set<std::string> parameters_only;
-  for (const auto& p : parameters_) parameters_only.insert(p.name);
-
-  auto check_expr = [&](const GiNaC::ex& e, const SourceLocation& where, const std::string& what,
-                        const std::set<std::string>& allowed) {
-    std::set<std::string> syms;
-    collect_symbols(e, syms);
-    for (const auto& s : syms)
-      if (!allowed.count(s))
-        throw ModelError(where, what + " may not depend on '" + s + "'");
-  };
+  // Parameters and coordinates (no rates, no inputs); parameters only.
+  const std::set<std::string> position_only = symbol_names(true), parameters_only = symbol_names(false);
+  const auto& check_expr = check_symbols;
   auto check_marker = [&](const std::string& name, const SourceLocation& where, const std::string& who) {
     if (!has_marker(name)) {
       std::string known_markers;

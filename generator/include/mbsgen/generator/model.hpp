@@ -9,6 +9,7 @@
 #include <array>
 #include <map>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -442,6 +443,9 @@ class Model {
   void check_new_symbol(const std::string& name, const SourceLocation& where);
   void check_new_element(const std::string& name, const char* kind, const SourceLocation& where);
   void validate_force_output(const Output& output) const;
+  std::set<std::string> symbol_names(bool coordinates) const;
+  static void check_symbols(const GiNaC::ex& e, const SourceLocation& where, const std::string& what,
+                            const std::set<std::string>& allowed);
   void validate_constraints(const GiNaC::exmap& defaults) const;
 
   std::string name_;
