@@ -25,27 +25,11 @@ bool has_reactions(const Model& model) {
   return false;
 }
 
-// The tree's equations of `model` (which may carry joint probes, reactions.hpp); `accelerations`
-// are the symbols ÿ of `original`'s coordinates, registered when outputs need them.
-Equations derive_tree(const Model& model, const Model& original, const DeriveOptions& options) {
-  Equations eq;
-  eq.model = &model;
-  for (const auto& c : model.coordinates()) eq.y.push_back(c.position);
-  for (const auto& c : model.coordinates()) eq.yd.push_back(c.velocity);
-  eq.u = model.input_symbols();
-  for (const auto& p : model.parameters()) eq.p.push_back(p.symbol);
-  if (has_reactions(original))
-    for (const auto& c : original.coordinates()) eq.ydd.push_back(GiNaC::symbol(c.name + "_ddot"));
+// Per-body wrench: inertial minus applied, about the world origin.
+std::vector<Spatial> body_wrenches(const Model& model, Equations& eq) {
   Program& prog = eq.program;
-  for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p, &eq.ydd})
-    for (const auto& s : *group) prog.add_variable(s);
-
-  eq.kinematics = compute_kinematics(model, prog);
   Kinematics& kin = eq.kinematics;
-  const std::size_t f = eq.y.size();
   const std::size_t nb = kin.bodies.size();
-
-  // Per-body wrench: inertial minus applied, about the world origin.
   std::vector<Spatial> wrench(nb);
   for (std::size_t i = 0; i < nb; ++i) {
     const BodyKinematics& b = kin.bodies[i];
@@ -73,82 +57,100 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
   }
   for (std::size_t i = 0; i < nb; ++i) wrench[i] = define(prog, wrench[i]);
 
-  if (options.projection == Projection::naive) {
-    // J̄_i column by column (coordinate j: the sum of the φ with coordinate j on i's root path),
-    // then M += J̄_iᵀ (Ī_i J̄_i) and k − q += J̄_iᵀ f̄_i for every body, no subtree sums.
-    eq.residual.assign(f, 0);
-    eq.M.assign(f, std::vector<ex>(f, 0));
-    for (std::size_t i = 0; i < nb; ++i) {
-      std::vector<std::pair<std::size_t, Spatial>> J;  // (coordinate, column), root path order
-      for (int k = static_cast<int>(i); k >= 0; k = kin.bodies[static_cast<std::size_t>(k)].parent)
-        for (const auto& col : kin.bodies[static_cast<std::size_t>(k)].columns) {
-          auto j = static_cast<std::size_t>(col.coordinate);
-          auto it = std::find_if(J.begin(), J.end(), [j](const auto& c) { return c.first == j; });
-          if (it == J.end())
-            J.emplace_back(j, col.phi);
-          else
-            it->second = add(it->second, col.phi);
-        }
-      std::vector<Spatial> IJ;
-      for (auto& c : J) {
-        c.second = define(prog, c.second);
-        IJ.push_back(define(prog, apply(kin.bodies[i].inertia, c.second)));
-      }
-      for (std::size_t a = 0; a < J.size(); ++a) {
-        eq.residual[J[a].first] += dot(J[a].second, wrench[i]);
-        for (std::size_t b = 0; b < J.size(); ++b)
-          if (J[a].first <= J[b].first) eq.M[J[a].first][J[b].first] += dot(J[a].second, IJ[b]);
-      }
-    }
-    for (std::size_t j = 0; j < f; ++j)
-      for (std::size_t k = j + 1; k < f; ++k) eq.M[k][j] = eq.M[j][k];
-  } else {
-    // Backward pass: composite wrenches and composite inertias.
-    std::vector<Spatial> Fc = wrench;
-    std::vector<SpatialInertia> Ic(nb);
-    for (std::size_t i = 0; i < nb; ++i) Ic[i] = kin.bodies[i].inertia;
-    for (std::size_t i = nb; i-- > 0;) {
-      Fc[i] = define(prog, Fc[i]);
-      Ic[i].m = prog.define(Ic[i].m);
-      Ic[i].h = define(prog, Ic[i].h);
-      Ic[i].J = define(prog, Ic[i].J);
-      int p = kin.bodies[i].parent;
-      if (p < 0) continue;
-      auto up = static_cast<std::size_t>(p);
-      Fc[up] = add(Fc[up], Fc[i]);
-      Ic[up].m = Ic[up].m + Ic[i].m;
-      Ic[up].h = add(Ic[up].h, Ic[i].h);
-      for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < 3; ++c) Ic[up].J[a][c] = Ic[up].J[a][c] + Ic[i].J[a][c];
-    }
+  return wrench;
+}
 
-    // Residual k − q from the joints, M from composite inertias.
-    eq.residual.assign(f, 0);
-    struct Column { std::size_t body; const Spatial* phi; Spatial force; };
-    std::vector<std::vector<Column>> by_coordinate(f);
-    for (std::size_t i = 0; i < nb; ++i)
-      for (const auto& col : kin.bodies[i].columns) {
+// J̄_i column by column (coordinate j: the sum of the φ with coordinate j on i's root path),
+// then M += J̄_iᵀ (Ī_i J̄_i) and k − q += J̄_iᵀ f̄_i for every body, no subtree sums.
+void project_naive(Equations& eq, const std::vector<Spatial>& wrench) {
+  Program& prog = eq.program;
+  Kinematics& kin = eq.kinematics;
+  const std::size_t f = eq.y.size();
+  const std::size_t nb = kin.bodies.size();
+  eq.residual.assign(f, 0);
+  eq.M.assign(f, std::vector<ex>(f, 0));
+  for (std::size_t i = 0; i < nb; ++i) {
+    std::vector<std::pair<std::size_t, Spatial>> J;  // (coordinate, column), root path order
+    for (int k = static_cast<int>(i); k >= 0; k = kin.bodies[static_cast<std::size_t>(k)].parent)
+      for (const auto& col : kin.bodies[static_cast<std::size_t>(k)].columns) {
         auto j = static_cast<std::size_t>(col.coordinate);
-        eq.residual[j] += dot(col.phi, Fc[i]);
-        by_coordinate[j].push_back({i, &col.phi, define(prog, apply(Ic[i], col.phi))});
+        auto it = std::find_if(J.begin(), J.end(), [j](const auto& c) { return c.first == j; });
+        if (it == J.end())
+          J.emplace_back(j, col.phi);
+        else
+          it->second = add(it->second, col.phi);
       }
-    eq.M.assign(f, std::vector<ex>(f, 0));
-    for (std::size_t j = 0; j < f; ++j)
-      for (std::size_t k = j; k < f; ++k) {
-        ex m = 0;
-        for (const auto& a : by_coordinate[j])
-          for (const auto& b : by_coordinate[k]) {
-            int ia = static_cast<int>(a.body), ib = static_cast<int>(b.body);
-            if (kin.is_ancestor_or_self(ia, ib))
-              m += dot(*a.phi, b.force);
-            else if (kin.is_ancestor_or_self(ib, ia))
-              m += dot(*b.phi, a.force);
-          }
-        eq.M[j][k] = eq.M[k][j] = m;
-      }
+    std::vector<Spatial> IJ;
+    for (auto& c : J) {
+      c.second = define(prog, c.second);
+      IJ.push_back(define(prog, apply(kin.bodies[i].inertia, c.second)));
+    }
+    for (std::size_t a = 0; a < J.size(); ++a) {
+      eq.residual[J[a].first] += dot(J[a].second, wrench[i]);
+      for (std::size_t b = 0; b < J.size(); ++b)
+        if (J[a].first <= J[b].first) eq.M[J[a].first][J[b].first] += dot(J[a].second, IJ[b]);
+    }
+  }
+  for (std::size_t j = 0; j < f; ++j)
+    for (std::size_t k = j + 1; k < f; ++k) eq.M[k][j] = eq.M[j][k];
+}
+
+// Backward pass: composite wrenches and composite inertias; M from composite inertias.
+void project_composite(Equations& eq, const std::vector<Spatial>& wrench) {
+  Program& prog = eq.program;
+  Kinematics& kin = eq.kinematics;
+  const std::size_t f = eq.y.size();
+  const std::size_t nb = kin.bodies.size();
+  // Backward pass: composite wrenches and composite inertias.
+  std::vector<Spatial> Fc = wrench;
+  std::vector<SpatialInertia> Ic(nb);
+  for (std::size_t i = 0; i < nb; ++i) Ic[i] = kin.bodies[i].inertia;
+  for (std::size_t i = nb; i-- > 0;) {
+    Fc[i] = define(prog, Fc[i]);
+    Ic[i].m = prog.define(Ic[i].m);
+    Ic[i].h = define(prog, Ic[i].h);
+    Ic[i].J = define(prog, Ic[i].J);
+    int p = kin.bodies[i].parent;
+    if (p < 0) continue;
+    auto up = static_cast<std::size_t>(p);
+    Fc[up] = add(Fc[up], Fc[i]);
+    Ic[up].m = Ic[up].m + Ic[i].m;
+    Ic[up].h = add(Ic[up].h, Ic[i].h);
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < 3; ++c) Ic[up].J[a][c] = Ic[up].J[a][c] + Ic[i].J[a][c];
   }
 
-  // Conservative and dissipative elements: q = −∂V/∂y − ∂R/∂ẏ.
+  // Residual k − q from the joints, M from composite inertias.
+  eq.residual.assign(f, 0);
+  struct Column { std::size_t body; const Spatial* phi; Spatial force; };
+  std::vector<std::vector<Column>> by_coordinate(f);
+  for (std::size_t i = 0; i < nb; ++i)
+    for (const auto& col : kin.bodies[i].columns) {
+      auto j = static_cast<std::size_t>(col.coordinate);
+      eq.residual[j] += dot(col.phi, Fc[i]);
+      by_coordinate[j].push_back({i, &col.phi, define(prog, apply(Ic[i], col.phi))});
+    }
+  eq.M.assign(f, std::vector<ex>(f, 0));
+  for (std::size_t j = 0; j < f; ++j)
+    for (std::size_t k = j; k < f; ++k) {
+      ex m = 0;
+      for (const auto& a : by_coordinate[j])
+        for (const auto& b : by_coordinate[k]) {
+          int ia = static_cast<int>(a.body), ib = static_cast<int>(b.body);
+          if (kin.is_ancestor_or_self(ia, ib))
+            m += dot(*a.phi, b.force);
+          else if (kin.is_ancestor_or_self(ib, ia))
+            m += dot(*b.phi, a.force);
+        }
+      eq.M[j][k] = eq.M[k][j] = m;
+    }
+}
+
+// Conservative and dissipative elements (q = −∂V/∂y − ∂R/∂ẏ) and generalized forces.
+void add_force_elements(const Model& model, Equations& eq) {
+  Program& prog = eq.program;
+  Kinematics& kin = eq.kinematics;
+  const std::size_t f = eq.y.size();
   ex V = 0, R = 0;
   for (const auto& s : model.springs()) {
     Vec3 d = define(prog, sub(kin.marker_position(model, prog, s.marker_b),
@@ -199,7 +201,11 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
   for (const auto& g : model.generalized_forces())
     eq.residual[static_cast<std::size_t>(model.coordinate_index(g.coordinate))] -= g.value;
 
-  // Outputs.
+}
+
+void derive_outputs(const Model& model, Equations& eq) {
+  Program& prog = eq.program;
+  Kinematics& kin = eq.kinematics;
   for (const auto& o : model.outputs()) {
     switch (o.kind) {
       case OutputKind::position:
@@ -225,6 +231,36 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
         break;
     }
   }
+
+}
+
+// The tree's equations of `model` (which may carry joint probes, reactions.hpp), with the
+// accelerations ÿ of `original`'s coordinates as variables when its outputs need them.
+Equations derive_tree(const Model& model, const Model& original, const DeriveOptions& options) {
+  Equations eq;
+  eq.model = &model;
+  for (const auto& c : model.coordinates()) eq.y.push_back(c.position);
+  for (const auto& c : model.coordinates()) eq.yd.push_back(c.velocity);
+  eq.u = model.input_symbols();
+  for (const auto& p : model.parameters()) eq.p.push_back(p.symbol);
+  if (has_reactions(original))
+    for (const auto& c : original.coordinates()) eq.ydd.push_back(GiNaC::symbol(c.name + "_ddot"));
+  Program& prog = eq.program;
+  for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p, &eq.ydd})
+    for (const auto& s : *group) prog.add_variable(s);
+
+  eq.kinematics = compute_kinematics(model, prog);
+  Kinematics& kin = eq.kinematics;
+  const std::size_t f = eq.y.size();
+  const std::size_t nb = kin.bodies.size();
+
+  const std::vector<Spatial> wrench = body_wrenches(model, eq);
+  if (options.projection == Projection::naive)
+    project_naive(eq, wrench);
+  else
+    project_composite(eq, wrench);
+  add_force_elements(model, eq);
+  derive_outputs(model, eq);
 
   // Body Jacobians (for the invariant M = J̄ᵀ M̄ J̄): J̄_i is the sum of φ along the root path,
   // and the centre-of-mass velocity is v_O + ω × c.
