@@ -545,6 +545,120 @@ std::string sparsity_json(const LinearEquations& lin) {
 
 }  // namespace
 
+// The header: the preamble (banner, operation counts), the scene's macros, sizes, names and the
+// kernels' declarations.
+std::string header_text(const Model& model, const Equations& eq, const LinearEquations& lin, const SceneSelection& scene,
+                        const GeneratedCode& out, const std::string& preamble) {
+  const bool loops = eq.loops.active;
+  const std::size_t f = lin.M.size(), n = eq.y.size(), m = eq.u.size(), r = eq.outputs.size();
+  const std::size_t nb = model.bodies().size(), np = eq.p.size();
+  std::ostringstream h;
+  h << preamble << "#pragma once\n\n";
+  h << "#define " << out.id << "_ABI_VERSION " << kAbiVersion << "\n";
+  h << "#define " << out.id << "_SCENE " << cpp_string_literal(scene.name) << "\n";
+  for (const auto& k : out.kernels) h << "#define " << out.id << "_HAS_" << upper(k.name) << " 1\n";
+  for (Analysis a : scene.analyses) h << "#define " << out.id << "_ANALYSIS_" << upper(to_string(a)) << " 1\n";
+  if (const auto& fr = scene.frequency_range)
+    h << "#define " << out.id << "_FREQUENCY_FROM_HZ " << format_double(fr->from_hz) << "\n#define "
+      << out.id << "_FREQUENCY_TO_HZ " << format_double(fr->to_hz) << "\n#define " << out.id
+      << "_FREQUENCY_POINTS " << fr->points << "\n#define " << out.id << "_FREQUENCY_LOG "
+      << (fr->logarithmic ? 1 : 0) << "\n";
+  h << "\n";
+  h << "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
+  h << "enum {\n  " << out.id << "_n_coordinates = " << f << ",\n  " << out.id
+    << "_n_inputs = " << m << ",\n  " << out.id << "_n_outputs = " << r << ",\n  " << out.id
+    << "_n_parameters = " << np << ",\n  " << out.id << "_n_bodies = " << nb << ",\n  "
+    << out.id << "_at_rest = " << (lin.at_rest ? 1 : 0) << ",\n  " << out.id
+    << "_equilibrium = " << (lin.equilibrium ? 1 : 0) << ",\n  " << out.id << "_D_zero = "
+    << (lin.D_zero ? 1 : 0) << ",\n  " << out.id << "_G_zero = " << (lin.G_zero ? 1 : 0)
+    << ",\n  " << out.id << "_N_zero = " << (lin.N_zero ? 1 : 0) << "\n};\n\n";
+  h << "int " << out.id << "_abi_version(void);\n";
+  h << "extern const char* const " << out.id << "_coordinate_names[];\n";
+  h << "extern const char* const " << out.id << "_parameter_names[];\n";
+  h << "extern const double " << out.id << "_parameter_defaults[];\n";
+  h << "extern const char* const " << out.id << "_input_names[];\n";
+  h << "extern const char* const " << out.id << "_output_names[];\n";
+  if (loops)
+    h << "// Closed loops: the kernels take the independent coordinates (coordinate_names); "
+         "assemble\n// and the constraint kernels all " << n << " tree coordinates.\nenum { " << out.id
+      << "_n_tree_coordinates = " << n << ", " << out.id << "_n_constraints = " << eq.loops.equations.size()
+      << " };\nextern const char* const " << out.id << "_tree_coordinate_names[];\n";
+  h << "\n";
+  for (const auto& k : out.kernels) h << k.signature << ";\n";
+  h << "\n#ifdef __cplusplus\n}\n#endif\n";
+  return h.str();
+}
+
+// The JSON manifest: the scene, the names and units, the operating point, the effects, the
+// structure and sparsity of the linear matrices, closed loops and the kernels with their counts.
+std::string manifest_json(const Model& model, const Equations& eq, const LinearEquations& lin, const SceneSelection& scene,
+                          const GeneratedCode& out) {
+  const bool loops = eq.loops.active;
+  const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
+  const std::size_t nb = model.bodies().size(), np = eq.p.size();
+  std::ostringstream j;
+  j << "{\n  \"generator\": \"mbsgen " << kGeneratorVersion << "\",\n  \"abi_version\": " << kAbiVersion
+    << ",\n  \"model\": " << json_string(model.name()) << ",\n  \"scene\": " << json_string(scene.name)
+    << ",\n  \"description\": " << json_string(scene.description) << ",\n  \"id\": " << json_string(out.id)
+    << ",\n  \"analyses\": [";
+  for (std::size_t i = 0; i < scene.analyses.size(); ++i)
+    j << (i ? ", " : "") << json_string(to_string(scene.analyses[i]));
+  j << "],\n  \"frequency_range\": ";
+  if (const auto& fr = scene.frequency_range)
+    j << "{\"from_hz\": " << format_double(fr->from_hz) << ", \"to_hz\": " << format_double(fr->to_hz)
+      << ", \"points\": " << fr->points << ", \"spacing\": " << (fr->logarithmic ? "\"log\"" : "\"linear\"")
+      << "}";
+  else
+    j << "null";
+  j << ",\n  \"coordinates\": [";
+  for (std::size_t i = 0; i < f; ++i) {
+    const Coordinate& q = model.coordinates()[loops ? eq.loops.independent[i] : i];
+    j << (i ? ", " : "") << "{\"name\": " << json_string(q.name) << ", \"unit\": " << json_string(q.unit) << "}";
+  }
+  j << "]";
+  if (loops) j << ",\n  \"constraints\": " << constraints_json(model, eq.loops);
+  j << ",\n  \"parameters\": [";
+  for (std::size_t i = 0; i < np; ++i) {
+    const auto& q = model.parameters()[i];
+    j << (i ? ",\n    " : "\n    ") << "{\"name\": " << json_string(q.name)
+      << ", \"value\": " << format_double(q.value) << ", \"unit\": " << json_string(q.unit)
+      << ", \"source\": " << json_string(q.source) << "}";
+  }
+  j << "],\n  \"inputs\": [";
+  for (std::size_t i = 0; i < m; ++i)
+    j << (i ? ", " : "") << "{\"name\": " << json_string(model.inputs()[i].name)
+      << ", \"unit\": " << json_string(model.inputs()[i].unit) << "}";
+  j << "],\n  \"outputs\": [";
+  for (std::size_t i = 0; i < r; ++i)
+    j << (i ? ", " : "") << "{\"name\": " << json_string(model.outputs()[i].name)
+      << ", \"unit\": " << json_string(model.outputs()[i].unit) << "}";
+  j << "],\n  \"bodies\": [";
+  for (std::size_t i = 0; i < nb; ++i) j << (i ? ", " : "") << json_string(model.bodies()[i].name);
+  j << "],\n  \"operating_point\": {\"kind\": "
+    << (lin.equilibrium ? "\"equilibrium\"" : "\"given\"") << ", \"at_rest\": "
+    << (lin.at_rest ? "true" : "false") << ", \"zero_rates\": [";
+  for (std::size_t i = 0; i < lin.zero_rates.size(); ++i)
+    j << (i ? ", " : "") << json_string(model.coordinates()[lin.zero_rates[i]].name);
+  j << "]},\n  \"effects\": [";
+  for (std::size_t i = 0; i < scene.effects.size(); ++i) {
+    const EffectState& e = scene.effects[i];
+    j << (i ? "," : "") << "\n    {\"name\": " << json_string(e.name) << ", \"category\": "
+      << json_string(e.category) << ", \"active\": " << (e.active ? "true" : "false");
+    if (!e.note.empty()) j << ", \"note\": " << json_string(e.note);
+    j << "}";
+  }
+  auto zero = [](bool z) { return z ? "\"zero\"" : "\"nonzero\""; };
+  j << "\n  ],\n  \"structure\": {\"D\": " << zero(lin.D_zero) << ", \"G\": " << zero(lin.G_zero)
+    << ", \"N\": " << zero(lin.N_zero) << "},\n  \"sparsity\": " << sparsity_json(lin)
+    << ",\n  \"kernels\": [";
+  for (std::size_t i = 0; i < out.kernels.size(); ++i)
+    j << (i ? "," : "") << "\n    {\"name\": " << json_string(out.kernels[i].name)
+      << ", \"operations\": " << out.kernels[i].operations
+      << ", \"signature\": " << json_string(out.kernels[i].signature) << "}";
+  j << "\n  ]\n}\n";
+  return j.str();
+}
+
 // The kernels of docs/generator.md, in emission order. With closed loops the coordinates y are
 // the tree's (n), the rates yd the independent ones, and the matrices those of the independent
 // coordinates (f); such kernels are wrapped (Kernel::wrapped).
@@ -663,9 +777,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
                                        : model.name() + "_" + scene.name);
   if (reserved_identifier(out.id)) out.id += "_";
   const bool loops = eq.loops.active;
-  const std::size_t f = lin.M.size(), n = eq.y.size(), m = eq.u.size(), r = eq.outputs.size();
-  const std::size_t nb = model.bodies().size();
-  std::vector<ex> p(eq.p.begin(), eq.p.end());
+  const std::size_t n = eq.y.size();
   std::vector<Kernel> kernels = model_kernels(model, eq, lin);
   std::ostringstream kernel_code;
   if (loops) {
@@ -703,41 +815,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   for (const auto& k : out.kernels) ops << " " << k.name << " " << k.operations << ";";
   ops << "\n";
 
-  std::ostringstream h;
-  h << banner << ops.str() << "#pragma once\n\n";
-  h << "#define " << out.id << "_ABI_VERSION " << kAbiVersion << "\n";
-  h << "#define " << out.id << "_SCENE " << cpp_string_literal(scene.name) << "\n";
-  for (const auto& k : out.kernels) h << "#define " << out.id << "_HAS_" << upper(k.name) << " 1\n";
-  for (Analysis a : scene.analyses) h << "#define " << out.id << "_ANALYSIS_" << upper(to_string(a)) << " 1\n";
-  if (const auto& fr = scene.frequency_range)
-    h << "#define " << out.id << "_FREQUENCY_FROM_HZ " << format_double(fr->from_hz) << "\n#define "
-      << out.id << "_FREQUENCY_TO_HZ " << format_double(fr->to_hz) << "\n#define " << out.id
-      << "_FREQUENCY_POINTS " << fr->points << "\n#define " << out.id << "_FREQUENCY_LOG "
-      << (fr->logarithmic ? 1 : 0) << "\n";
-  h << "\n";
-  h << "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
-  h << "enum {\n  " << out.id << "_n_coordinates = " << f << ",\n  " << out.id
-    << "_n_inputs = " << m << ",\n  " << out.id << "_n_outputs = " << r << ",\n  " << out.id
-    << "_n_parameters = " << p.size() << ",\n  " << out.id << "_n_bodies = " << nb << ",\n  "
-    << out.id << "_at_rest = " << (lin.at_rest ? 1 : 0) << ",\n  " << out.id
-    << "_equilibrium = " << (lin.equilibrium ? 1 : 0) << ",\n  " << out.id << "_D_zero = "
-    << (lin.D_zero ? 1 : 0) << ",\n  " << out.id << "_G_zero = " << (lin.G_zero ? 1 : 0)
-    << ",\n  " << out.id << "_N_zero = " << (lin.N_zero ? 1 : 0) << "\n};\n\n";
-  h << "int " << out.id << "_abi_version(void);\n";
-  h << "extern const char* const " << out.id << "_coordinate_names[];\n";
-  h << "extern const char* const " << out.id << "_parameter_names[];\n";
-  h << "extern const double " << out.id << "_parameter_defaults[];\n";
-  h << "extern const char* const " << out.id << "_input_names[];\n";
-  h << "extern const char* const " << out.id << "_output_names[];\n";
-  if (loops)
-    h << "// Closed loops: the kernels take the independent coordinates (coordinate_names); "
-         "assemble\n// and the constraint kernels all " << n << " tree coordinates.\nenum { " << out.id
-      << "_n_tree_coordinates = " << n << ", " << out.id << "_n_constraints = " << eq.loops.equations.size()
-      << " };\nextern const char* const " << out.id << "_tree_coordinate_names[];\n";
-  h << "\n";
-  for (const auto& k : out.kernels) h << k.signature << ";\n";
-  h << "\n#ifdef __cplusplus\n}\n#endif\n";
-  out.header = h.str();
+  out.header = header_text(model, eq, lin, scene, out, banner + ops.str());
 
   auto names_array = [&](const std::string& what, const std::vector<std::string>& names) {
     std::ostringstream s;
@@ -769,68 +847,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   c << kernel_code.str();
   out.source = c.str();
 
-  // Manifest.
-  std::ostringstream j;
-  j << "{\n  \"generator\": \"mbsgen " << kGeneratorVersion << "\",\n  \"abi_version\": " << kAbiVersion
-    << ",\n  \"model\": " << json_string(model.name()) << ",\n  \"scene\": " << json_string(scene.name)
-    << ",\n  \"description\": " << json_string(scene.description) << ",\n  \"id\": " << json_string(out.id)
-    << ",\n  \"analyses\": [";
-  for (std::size_t i = 0; i < scene.analyses.size(); ++i)
-    j << (i ? ", " : "") << json_string(to_string(scene.analyses[i]));
-  j << "],\n  \"frequency_range\": ";
-  if (const auto& fr = scene.frequency_range)
-    j << "{\"from_hz\": " << format_double(fr->from_hz) << ", \"to_hz\": " << format_double(fr->to_hz)
-      << ", \"points\": " << fr->points << ", \"spacing\": " << (fr->logarithmic ? "\"log\"" : "\"linear\"")
-      << "}";
-  else
-    j << "null";
-  j << ",\n  \"coordinates\": [";
-  for (std::size_t i = 0; i < f; ++i) {
-    const Coordinate& q = model.coordinates()[loops ? eq.loops.independent[i] : i];
-    j << (i ? ", " : "") << "{\"name\": " << json_string(q.name) << ", \"unit\": " << json_string(q.unit) << "}";
-  }
-  j << "]";
-  if (loops) j << ",\n  \"constraints\": " << constraints_json(model, eq.loops);
-  j << ",\n  \"parameters\": [";
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const auto& q = model.parameters()[i];
-    j << (i ? ",\n    " : "\n    ") << "{\"name\": " << json_string(q.name)
-      << ", \"value\": " << format_double(q.value) << ", \"unit\": " << json_string(q.unit)
-      << ", \"source\": " << json_string(q.source) << "}";
-  }
-  j << "],\n  \"inputs\": [";
-  for (std::size_t i = 0; i < m; ++i)
-    j << (i ? ", " : "") << "{\"name\": " << json_string(model.inputs()[i].name)
-      << ", \"unit\": " << json_string(model.inputs()[i].unit) << "}";
-  j << "],\n  \"outputs\": [";
-  for (std::size_t i = 0; i < r; ++i)
-    j << (i ? ", " : "") << "{\"name\": " << json_string(model.outputs()[i].name)
-      << ", \"unit\": " << json_string(model.outputs()[i].unit) << "}";
-  j << "],\n  \"bodies\": [";
-  for (std::size_t i = 0; i < nb; ++i) j << (i ? ", " : "") << json_string(model.bodies()[i].name);
-  j << "],\n  \"operating_point\": {\"kind\": "
-    << (lin.equilibrium ? "\"equilibrium\"" : "\"given\"") << ", \"at_rest\": "
-    << (lin.at_rest ? "true" : "false") << ", \"zero_rates\": [";
-  for (std::size_t i = 0; i < lin.zero_rates.size(); ++i)
-    j << (i ? ", " : "") << json_string(model.coordinates()[lin.zero_rates[i]].name);
-  j << "]},\n  \"effects\": [";
-  for (std::size_t i = 0; i < scene.effects.size(); ++i) {
-    const EffectState& e = scene.effects[i];
-    j << (i ? "," : "") << "\n    {\"name\": " << json_string(e.name) << ", \"category\": "
-      << json_string(e.category) << ", \"active\": " << (e.active ? "true" : "false");
-    if (!e.note.empty()) j << ", \"note\": " << json_string(e.note);
-    j << "}";
-  }
-  auto zero = [](bool z) { return z ? "\"zero\"" : "\"nonzero\""; };
-  j << "\n  ],\n  \"structure\": {\"D\": " << zero(lin.D_zero) << ", \"G\": " << zero(lin.G_zero)
-    << ", \"N\": " << zero(lin.N_zero) << "},\n  \"sparsity\": " << sparsity_json(lin)
-    << ",\n  \"kernels\": [";
-  for (std::size_t i = 0; i < out.kernels.size(); ++i)
-    j << (i ? "," : "") << "\n    {\"name\": " << json_string(out.kernels[i].name)
-      << ", \"operations\": " << out.kernels[i].operations
-      << ", \"signature\": " << json_string(out.kernels[i].signature) << "}";
-  j << "\n  ]\n}\n";
-  out.manifest = j.str();
+  out.manifest = manifest_json(model, eq, lin, scene, out);
   return out;
 }
 
