@@ -11,8 +11,8 @@
 namespace {
 
 double median_us(double offset) {
-  const int n = four_bar_linkage_n_coordinates;
-  std::vector<double> y0(n), yd0(n, 0.0), M(n * n), Q(n * n), K(n * n), B(1), Cy(1), Cv(1);
+  const int n = four_bar_linkage_n_coordinates, m = four_bar_linkage_n_inputs, r = four_bar_linkage_n_outputs;
+  std::vector<double> y0(n), yd0(n, 0.0), M(n * n), Q(n * n), K(n * n), B(n * m), Cy(r * n), Cv(r * n);
   const double* p = four_bar_linkage_parameter_defaults;
   four_bar_linkage_operating_point(p, y0.data(), yd0.data());
   const double start = y0[0] + offset;
