@@ -171,6 +171,10 @@ int main(int argc, char** argv) try {
     const mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
     progress.stage("deriving the equations");
     mbsgen::Equations eq = mbsgen::derive(pruned);
+    for (const auto& [e, why] : eq.loops.dropped)
+      if (eq.loops.redundant && why.rfind("redundant", 0) == 0)
+        std::cerr << "mbsgen: warning: constraint '" << e.constraint << "'"
+                  << (e.component.empty() ? "" : " (" + e.component + ")") << " dropped: " << why << "\n";
     progress.stage("linearizing");
     mbsgen::LinearEquations lin = mbsgen::linearize(eq);
     progress.stage("checking the operating point");
