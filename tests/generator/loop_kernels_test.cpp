@@ -203,4 +203,37 @@ TEST(SliderCrank, EquilibriumFrequencyAndEveryJointLoad) {
   for (int i = 0; i < 9; ++i) EXPECT_NEAR(z[i], expected[i], 1e-12) << slider_crank_output_names[i];
 }
 
+// Invariant on every model with loops: at the operating point (and 0.05 rad or m away in each
+// independent coordinate) assemble closes every constraint equation to rounding.
+struct LoopKernels {
+  const char* name;
+  int n, n_tree, n_constraints, n_parameters;
+  const double* defaults;
+  int (*operating_point)(const double*, double*, double*);
+  int (*assemble)(const double*, const double*, double*);
+  int (*constraints)(const double*, const double*, double*);
+};
+#define LOOP_ENTRY(id)                                                                                        \
+  LoopKernels {                                                                                               \
+    #id, id##_n_coordinates, id##_n_tree_coordinates, id##_n_constraints, id##_n_parameters,                   \
+        id##_parameter_defaults, id##_operating_point, id##_assemble, id##_constraints                         \
+  }
+
+TEST(LoopInvariants, AssembleClosesEveryLoopModel) {
+  for (const LoopKernels& k : {LOOP_ENTRY(four_bar_linkage), LOOP_ENTRY(ladder_3), LOOP_ENTRY(four_bar),
+                               LOOP_ENTRY(slider_crank)}) {
+    std::vector<double> yi(static_cast<std::size_t>(k.n)), yd(yi.size()), y(static_cast<std::size_t>(k.n_tree)),
+        phi(static_cast<std::size_t>(k.n_constraints));
+    ASSERT_EQ(k.operating_point(k.defaults, yi.data(), yd.data()), 0) << k.name;
+    for (int j = -1; j < k.n; ++j) {
+      std::vector<double> at = yi;
+      if (j >= 0) at[static_cast<std::size_t>(j)] += 0.05;
+      ASSERT_EQ(k.assemble(at.data(), k.defaults, y.data()), 0) << k.name << " " << j;
+      ASSERT_EQ(k.constraints(y.data(), k.defaults, phi.data()), 0) << k.name;
+      // Lengths of 0.1–0.6 m: a few ulps after the last Newton step.
+      for (double r : phi) EXPECT_LE(std::abs(r), 1e-15) << k.name << " " << j;
+    }
+  }
+}
+
 }  // namespace
