@@ -1,5 +1,7 @@
 #include "mbsgen/runtime/solver_cli.hpp"
 
+#include "mbsgen/runtime/parameter_sweep.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <unistd.h>
@@ -40,6 +42,7 @@ struct Options {
   std::string input, output, method = "auto", spacing = "log", on_pole = "flag", plot, out_dir;
   long points = 200;
   double from = 0, to = 0;
+  std::string parameter;  ///< sweep
 };
 
 GeneratedModel configured(const ModelKernels& k, const Options& o) {
@@ -169,6 +172,45 @@ int run_static(const ModelKernels& k, const Options& o, std::ostream& out) {
   return 0;
 }
 
+// Eigenvalues against a parameter (parameter_sweep.hpp): one line per eigenvalue and value, then
+// the stability boundaries.
+int run_sweep(const ModelKernels& k, const Options& o, std::ostream& out) {
+  GeneratedModel model = configured(k, o);
+  const SweepResult r = sweep_parameter(model, o.parameter, o.from, o.to, static_cast<int>(o.points));
+  if (o.format == "json") {
+    out << "{\"parameter\":" << json_string(r.parameter) << ",\"points\":[";
+    for (std::size_t i = 0; i < r.points.size(); ++i) {
+      const SweepPoint& p = r.points[i];
+      out << (i ? "," : "") << "{\"value\":" << num(p.value, true) << ",\"stability\":"
+          << json_string(to_string(p.stability)) << ",\"eigenvalues\":[";
+      for (std::size_t j = 0; j < p.eigenvalues.size(); ++j)
+        out << (j ? "," : "") << "[" << num(p.eigenvalues[j].real(), true) << "," << num(p.eigenvalues[j].imag(), true) << "]";
+      out << "]}";
+    }
+    out << "],\"boundaries\":[";
+    for (std::size_t i = 0; i < r.boundaries.size(); ++i) {
+      const StabilityBoundary& b = r.boundaries[i];
+      out << (i ? "," : "") << "{\"value\":" << num(b.value, true) << ",\"tolerance\":" << num(b.tolerance, true)
+          << ",\"becomes\":" << (b.becomes_unstable ? "\"unstable\"" : "\"stable\"") << ",\"eigenvalue\":["
+          << num(b.eigenvalue.real(), true) << "," << num(b.eigenvalue.imag(), true) << "]}";
+    }
+    out << "]}\n";
+    return 0;
+  }
+  out << pad(r.parameter, 26) << pad("#", 4) << pad("Re lambda", 26) << pad("Im lambda", 26) << "  stability\n";
+  for (const SweepPoint& p : r.points)
+    for (std::size_t j = 0; j < p.eigenvalues.size(); ++j)
+      out << pad(num(p.value, false), 26) << pad(std::to_string(j + 1), 4) << pad(num(p.eigenvalues[j].real(), false), 26)
+          << pad(num(p.eigenvalues[j].imag(), false), 26) << "  " << to_string(p.stability) << "\n";
+  for (const StabilityBoundary& b : r.boundaries)
+    out << "# stability boundary: " << r.parameter << " = " << num(b.value, false) << " (+/- " << short_num(b.tolerance)
+        << "): " << (b.becomes_unstable ? "unstable" : "stable") << " above, eigenvalue "
+        << num(b.eigenvalue.real(), false) << " " << (b.eigenvalue.imag() < 0 ? "- " : "+ ")
+        << num(std::abs(b.eigenvalue.imag()), false) << "i\n";
+  if (r.boundaries.empty()) out << "# no stability boundary between " << num(o.from, false) << " and " << num(o.to, false) << "\n";
+  return 0;
+}
+
 void json_matrix(std::ostream& out, const Eigen::MatrixXd& A) {
   out << "[";
   for (Eigen::Index i = 0; i < A.rows(); ++i) {
@@ -287,6 +329,14 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   CLI::App* stat = app.add_subcommand("static", "the operating point: equilibrium, residual, iterations");
   add_set(stat);
   stat->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json"}));
+  CLI::App* sweep = app.add_subcommand("sweep", "eigenvalues against a parameter, and where the stability changes");
+  add_set(sweep);
+  sweep->add_option("--parameter", o.parameter, "the parameter swept")->required();
+  sweep->add_option("--from", o.from, "first value (SI)")->required();
+  sweep->add_option("--to", o.to, "last value (SI)")->required();
+  sweep->add_option("--points", o.points, "number of values, linear spacing (default 101)")
+      ->check(CLI::Range(2L, kMaxFrequencyPoints));
+  sweep->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json"}));
   CLI::App* matrices = app.add_subcommand("matrices", "M, Q, K, B, C_y, C_v (C_a, D) at the operating point");
   add_set(matrices);
   matrices->add_option("--format", o.format, "json (standard output) or mtx (files in --out)")
@@ -307,6 +357,7 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     return 2;
   }
   if (matrices->parsed() && o.format == "table") o.format = "json";
+  if (sweep->parsed() && sweep->get_option("--points")->count() == 0) o.points = 101;
   if (frf->parsed()) {
     const std::string problem = sweep_from_scene(k, *frf, o);
     if (!problem.empty()) {
@@ -319,6 +370,7 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     if (modes->parsed()) return run_modes(k, o, out);
     if (frf->parsed()) return run_frf(k, o, out, err);
     if (stat->parsed()) return run_static(k, o, out);
+    if (sweep->parsed()) return run_sweep(k, o, out);
     return run_matrices(k, o, out, err);
   } catch (const NameError& e) {
     err << program << ": " << e.what() << "\n";
