@@ -5,6 +5,7 @@
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/linear_model.hpp"
 #include "mbsgen/runtime/matrix_market.hpp"
+#include "mbsgen/runtime/parameter_sweep.hpp"
 #include "mbsgen/runtime/quadratic_eigen.hpp"
 #include "mbsgen/runtime/static_equilibrium.hpp"
 #include "mbsgen/runtime/version.hpp"
