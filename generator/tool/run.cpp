@@ -1,7 +1,8 @@
 // `mbsgen run MODEL [--scene NAME] -- ARGS`: generate, compile and cache a model's solver, then
 // run it with ARGS (docs/cli.md "Model solvers"). The solver is cached under a content hash of
-// the model file, the scene, the generator version and the compile command, so a second run
-// starts at once and any edit of the model rebuilds it. Nothing is written outside the cache.
+// the model file, the scene, the generator version, the compile command and the size and time of
+// the libraries it links, so a second run starts at once and any edit of the model (or rebuild of
+// the runtime) rebuilds it. Nothing is written outside the cache.
 #include "run.hpp"
 
 #include "mbsgen/generator/check.hpp"
@@ -226,7 +227,15 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   const Toolchain tc = toolchain();
   std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
   for (const auto& a : tc.includes) key += '\0' + a;
-  for (const auto& a : tc.libraries) key += '\0' + a;
+  // A library rebuilt in place (a developer's build tree) makes a new key: its size and time of
+  // modification are part of it, so a solver is never linked against an older runtime.
+  for (const auto& a : tc.libraries) {
+    key += '\0' + a;
+    std::error_code ec;
+    const auto size = fs::file_size(a, ec);
+    const auto time = fs::last_write_time(a, ec);
+    if (!ec) key += '\0' + std::to_string(size) + '\0' + std::to_string(time.time_since_epoch().count());
+  }
   char hash[17];
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(key)));
   const fs::path root = cache_root();
