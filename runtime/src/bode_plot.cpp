@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <system_error>
 
@@ -144,8 +145,11 @@ std::string gnuplot_string(const std::string& s) {
   return o + "'";
 }
 
-void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const Eigen::VectorXcd& g,
-                     const BodePlot& plot) {
+namespace {
+
+// Renders the script that `script(terminal)` gives to `path` (.svg or .png), atomically, with
+// gnuplot run without a shell in a private directory (see write_bode_plot).
+void render(const std::string& path, const std::function<std::string(const std::string&)>& script_for) {
   const std::string ext = fs::path(path).extension().string();
   std::string terminal;
   if (ext == ".svg")
@@ -156,10 +160,10 @@ void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const E
     throw Error("--plot " + path + ": the file name must end in .svg or .png");
 
   PrivateDirectory work;
-  const fs::path script = work.path / "bode.gp", log = work.path / "gnuplot.log";
+  const fs::path script = work.path / "plot.gp", log = work.path / "gnuplot.log";
   {
     std::ofstream s(script, std::ios::binary);
-    s << bode_script(terminal, hz, g, plot);
+    s << script_for(terminal);
     if (!s.flush()) throw Error("--plot: cannot write " + script.string());
   }
   // The plot goes to a file created exclusively beside the target, then renamed over it.
@@ -191,6 +195,43 @@ void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const E
   if (::rename(tmp.c_str(), target.c_str()) != 0)
     throw Error("--plot: cannot write " + target.string() + ": " + std::strerror(errno));
   remove_tmp.path.clear();
+}
+
+
+// The eigenvalues against the parameter: real parts above, imaginary parts below, the
+// stability boundaries as vertical lines.
+std::string sweep_script(const std::string& terminal, const SweepResult& r, const SweepPlot& plot) {
+  std::ostringstream s;
+  s << "set terminal " << terminal << "\n$sweep << EOD\n";
+  for (const SweepPoint& p : r.points)
+    for (const auto& l : p.eigenvalues) {
+      if (!std::isfinite(l.real()) || !std::isfinite(l.imag())) continue;
+      char line[128];
+      std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", p.value, l.real(), l.imag());
+      s << line;
+    }
+  s << "EOD\n"
+    << "set multiplot layout 2,1 title " << gnuplot_string(plot.title) << " noenhanced\n"
+    << "set grid xtics ytics\nunset key\n";
+  for (const StabilityBoundary& b : r.boundaries)
+    s << "set arrow from " << b.value << ", graph 0 to " << b.value << ", graph 1 nohead dt 2 lc rgb '#b03030'\n";
+  s << "set ylabel 'Re lambda [1/s]'\n"
+    << "plot $sweep using 1:2 with points pt 7 ps 0.4 lc rgb '#1f4e9c', 0 with lines lc rgb 'black'\n"
+    << "set ylabel 'Im lambda [1/s]'\nset xlabel " << gnuplot_string(plot.parameter_label) << " noenhanced\n"
+    << "plot $sweep using 1:3 with points pt 7 ps 0.4 lc rgb '#1f4e9c'\n"
+    << "unset multiplot\n";
+  return s.str();
+}
+
+}  // namespace
+
+void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const Eigen::VectorXcd& g,
+                     const BodePlot& plot) {
+  render(path, [&](const std::string& terminal) { return bode_script(terminal, hz, g, plot); });
+}
+
+void write_sweep_plot(const std::string& path, const SweepResult& r, const SweepPlot& plot) {
+  render(path, [&](const std::string& terminal) { return sweep_script(terminal, r, plot); });
 }
 
 }  // namespace mbsgen::cli

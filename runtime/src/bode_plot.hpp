@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 
+#include "mbsgen/runtime/parameter_sweep.hpp"
+
 namespace mbsgen::cli {
 
 struct BodePlot {
@@ -24,5 +26,14 @@ std::string gnuplot_string(const std::string& s);
 /// standard output. Throws mbsgen::Error when gnuplot is missing or fails.
 void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz,
                      const Eigen::VectorXcd& g, const BodePlot& plot);
+
+struct SweepPlot {
+  std::string title;
+  std::string parameter_label;  // e.g. "v [m/s]"
+};
+
+/// Writes the eigenvalues of a parameter sweep (real parts above, imaginary parts below, the
+/// stability boundaries as dashed vertical lines) to `path`, as write_bode_plot does.
+void write_sweep_plot(const std::string& path, const SweepResult& result, const SweepPlot& plot);
 
 }  // namespace mbsgen::cli

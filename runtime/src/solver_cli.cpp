@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -174,9 +175,19 @@ int run_static(const ModelKernels& k, const Options& o, std::ostream& out) {
 
 // Eigenvalues against a parameter (parameter_sweep.hpp): one line per eigenvalue and value, then
 // the stability boundaries.
-int run_sweep(const ModelKernels& k, const Options& o, std::ostream& out) {
+int run_sweep(const ModelKernels& k, const Options& o, std::ostream& out, std::ostream& err) {
   GeneratedModel model = configured(k, o);
+  if (!o.plot.empty()) refuse_special_file(o.plot, "--plot");  // before the sweep, not after
   const SweepResult r = sweep_parameter(model, o.parameter, o.from, o.to, static_cast<int>(o.points));
+  if (!o.plot.empty()) {
+    SweepPlot plot;
+    plot.title = std::string(k.model) + " (" + k.scene + "): eigenvalues against " + o.parameter;
+    const auto& names = model.parameter_names();
+    const auto index = std::find(names.begin(), names.end(), o.parameter) - names.begin();
+    plot.parameter_label = o.parameter + " [" + unit_or(k.parameter_units, static_cast<int>(index), "-") + "]";
+    write_sweep_plot(o.plot, r, plot);
+    err << "wrote " << o.plot << "\n";
+  }
   if (o.format == "json") {
     out << "{\"parameter\":" << json_string(r.parameter) << ",\"points\":[";
     for (std::size_t i = 0; i < r.points.size(); ++i) {
@@ -337,6 +348,7 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   sweep->add_option("--points", o.points, "number of values, linear spacing (default 101)")
       ->check(CLI::Range(2L, kMaxFrequencyPoints));
   sweep->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json"}));
+  sweep->add_option("--plot", o.plot, "write the eigenvalues against the parameter (FILE.svg or FILE.png)");
   CLI::App* matrices = app.add_subcommand("matrices", "M, Q, K, B, C_y, C_v (C_a, D) at the operating point");
   add_set(matrices);
   matrices->add_option("--format", o.format, "json (standard output) or mtx (files in --out)")
@@ -370,7 +382,7 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     if (modes->parsed()) return run_modes(k, o, out);
     if (frf->parsed()) return run_frf(k, o, out, err);
     if (stat->parsed()) return run_static(k, o, out);
-    if (sweep->parsed()) return run_sweep(k, o, out);
+    if (sweep->parsed()) return run_sweep(k, o, out, err);
     return run_matrices(k, o, out, err);
   } catch (const NameError& e) {
     err << program << ": " << e.what() << "\n";

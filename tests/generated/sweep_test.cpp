@@ -8,7 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -70,6 +75,26 @@ TEST(Sweep, SolverCommandPrintsTheBoundary) {
       << err.str();
   EXPECT_NE(out.str().find("# stability boundary: Omega = 300.0000000"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("unstable above"), std::string::npos) << out.str();
+}
+
+// --plot draws the eigenvalues against the parameter with gnuplot (an SVG: text we can read).
+TEST(Sweep, PlotIsWritten) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("sweep_plot_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string file = (dir / "omega.svg").string();
+  std::vector<std::string> args = {"jeffcott_rotor-solve", "sweep", "--parameter", "Omega", "--from", "0",
+                                   "--to", "500", "--points", "21", "--plot", file};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  std::ostringstream out, err;
+  ASSERT_EQ(mbsgen::cli::solver_main(jeffcott_rotor::kernels(), static_cast<int>(argv.size()), argv.data(), out, err), 0)
+      << err.str();
+  std::ifstream in(file);
+  const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  EXPECT_NE(svg.find("eigenvalues against Omega"), std::string::npos);
+  EXPECT_NE(svg.find("Omega [rad/s]"), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
