@@ -3,7 +3,10 @@
 // frequency, against an independent derivation in one minimal coordinate
 // (tests/reference/four_bar_linkage_reference.py, mpmath at 50 digits).
 #include "four_bar.hpp"
+#include "four_bar_given.hpp"
 #include "four_bar_linkage.hpp"
+#include "four_bar_parallelogram.hpp"
+#include "pendulum_cartesian.hpp"
 #include "ladder_3.hpp"
 #include "slider_crank.hpp"
 
@@ -203,6 +206,34 @@ TEST(SliderCrank, EquilibriumFrequencyAndEveryJointLoad) {
   for (int i = 0; i < 9; ++i) EXPECT_NEAR(z[i], expected[i], 1e-12) << slider_crank_output_names[i];
 }
 
+// The other linkage files against tests/data/reference/loops.json (tests/reference/
+// loops_reference.py: SymPy and mpmath, every value by two independent routes): the
+// parallelogram's ω² = 3g(m1+2m2+m3)/(2l(m1+3m2+m3)) = 36.7875 and its pin load (0, −2.4525) N, the
+// Cartesian pendulum's ω² = g/L = 12.2625, the loaded four-bar at its given equilibrium.
+TEST(LinkageFiles, MatchLoopsJson) {
+  struct Case {
+    mbsgen::ModelKernels k;
+    double omega2;
+    std::vector<double> loads;
+  };
+  mbsgen::ModelKernels parallelogram = LOOP_KERNELS(four_bar_parallelogram), pendulum = LOOP_KERNELS(pendulum_cartesian),
+                       given = LOOP_KERNELS(four_bar_given);
+  parallelogram.outputs = four_bar_parallelogram_outputs;
+  given.outputs = four_bar_given_outputs;
+  for (const Case& c : {Case{parallelogram, 36.7875, {0, -2.4525}}, Case{pendulum, 12.2625, {}},
+                        Case{given, kOmega2, {kPin[0], kPin[1], kPivot[0], kPivot[1]}}}) {
+    mbsgen::GeneratedModel model(c.k);
+    const mbsgen::OperatingPoint op = model.operating_point();
+    const mbsgen::LinearModel lin = model.linear_model(op);
+    ASSERT_EQ(lin.size(), 1) << c.k.model;
+    // 1e-12: the kernels at a point closed to rounding against 50-digit references.
+    EXPECT_NEAR(lin.K()(0, 0) / lin.M()(0, 0) / c.omega2, 1, 1e-12) << c.k.model;
+    const Eigen::VectorXd z = model.outputs(op);
+    for (std::size_t i = 0; i < c.loads.size(); ++i)
+      EXPECT_NEAR(z[static_cast<Eigen::Index>(i)], c.loads[i], 1e-12) << c.k.model << " output " << i;
+  }
+}
+
 // Invariant on every model with loops: at the operating point (and 0.05 rad or m away in each
 // independent coordinate) assemble closes every constraint equation to rounding.
 struct LoopKernels {
@@ -221,7 +252,8 @@ struct LoopKernels {
 
 TEST(LoopInvariants, AssembleClosesEveryLoopModel) {
   for (const LoopKernels& k : {LOOP_ENTRY(four_bar_linkage), LOOP_ENTRY(ladder_3), LOOP_ENTRY(four_bar),
-                               LOOP_ENTRY(slider_crank)}) {
+                               LOOP_ENTRY(slider_crank), LOOP_ENTRY(four_bar_given), LOOP_ENTRY(four_bar_parallelogram),
+                               LOOP_ENTRY(pendulum_cartesian)}) {
     std::vector<double> yi(static_cast<std::size_t>(k.n)), yd(yi.size()), y(static_cast<std::size_t>(k.n_tree)),
         phi(static_cast<std::size_t>(k.n_constraints));
     ASSERT_EQ(k.operating_point(k.defaults, yi.data(), yd.data()), 0) << k.name;
