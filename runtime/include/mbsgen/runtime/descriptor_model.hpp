@@ -1,0 +1,155 @@
+// First-order (descriptor) linear model  E ẋ = A x + B u,  z = C x + D u, its modes and its
+// frequency response. Nonholonomic systems (rolling wheels, the Whipple bicycle) have fewer
+// speeds than coordinates, so their linearization is not M ÿ + Q ẏ + K y = B u (linear_model.hpp)
+// but this form, with x = [coordinates; independent speeds] and, in practice,
+// E = blkdiag(I, M_r) with M_r symmetric positive definite. Everything here accepts a general
+// square E; a singular E gives infinite eigenvalues (EigenvalueKind::infinite).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "mbsgen/runtime/error.hpp"
+#include "mbsgen/runtime/frequency_response.hpp"
+#include "mbsgen/runtime/quadratic_eigen.hpp"
+
+namespace mbsgen {
+
+/// Read-only description of a linear descriptor model with n states, m inputs, p outputs:
+///
+///     E ẋ = A x + B u,      z = C x + D u.
+///
+/// - E (n×n): descriptor matrix, may be singular (algebraic equations, infinite eigenvalues);
+/// - A (n×n): state matrix; its exactly zero columns (ignorable coordinates, emitted by the
+///   generator as exact 0.0) give exact zero eigenvalues (DescriptorEigenSolver);
+/// - B (n×m): input matrix; C (p×n): output matrix; D (p×m): feedthrough (zero if not given).
+///
+/// The constructor validates dimensions and finiteness and throws DimensionError or
+/// NonFiniteError naming "DescriptorModel", the matrix and its dimensions. Names and units are
+/// optional (empty vectors give default names "x1".., "u1".., "z1".. and empty units).
+class DescriptorModel {
+ public:
+  /// E, A n×n (n ≥ 1); B n×m (m ≥ 0; 0×0 means m = 0); C p×n (p ≥ 0; 0×0 means p = 0);
+  /// D p×m, or 0×0 meaning zero.
+  DescriptorModel(Eigen::MatrixXd E, Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C,
+                  Eigen::MatrixXd D = {}, std::vector<std::string> state_names = {},
+                  std::vector<std::string> input_names = {},
+                  std::vector<std::string> output_names = {},
+                  std::vector<std::string> input_units = {},
+                  std::vector<std::string> output_units = {});
+
+  Eigen::Index size() const { return E_.rows(); }         ///< n, number of states
+  Eigen::Index num_inputs() const { return B_.cols(); }   ///< m
+  Eigen::Index num_outputs() const { return C_.rows(); }  ///< p
+
+  const Eigen::MatrixXd& E() const { return E_; }  ///< n×n descriptor matrix
+  const Eigen::MatrixXd& A() const { return A_; }  ///< n×n state matrix
+  const Eigen::MatrixXd& B() const { return B_; }  ///< n×m input matrix
+  const Eigen::MatrixXd& C() const { return C_; }  ///< p×n output matrix
+  const Eigen::MatrixXd& D() const { return D_; }  ///< p×m feedthrough (zeros if not given)
+
+  const std::vector<std::string>& state_names() const { return state_names_; }
+  const std::vector<std::string>& input_names() const { return input_names_; }
+  const std::vector<std::string>& output_names() const { return output_names_; }
+  const std::vector<std::string>& input_units() const { return input_units_; }
+  const std::vector<std::string>& output_units() const { return output_units_; }
+
+ private:
+  Eigen::MatrixXd E_, A_, B_, C_, D_;
+  std::vector<std::string> state_names_, input_names_, output_names_;
+  std::vector<std::string> input_units_, output_units_;
+};
+
+/// Options of DescriptorEigenSolver.
+struct DescriptorEigenOptions {
+  /// Relative normwise data uncertainty η_floor below which a backward error does not lower
+  /// Mode::error_bound; 0 means the default 100·n·u (as QuadraticEigenOptions); negative: no floor.
+  double backward_error_floor = 0.0;
+  /// Report each complex-conjugate pair once (the member with Im λ > 0).
+  bool one_per_conjugate_pair = false;
+};
+
+/// Solver for the n eigenpairs of the pencil λE − A, shaped like an Eigen decomposition.
+///
+/// 1. Exact zeros: every exactly zero column k of A (an ignorable coordinate) gives λ = 0 exactly,
+///    eigenvector e_k. They are deflated orthogonally (det(λE − A) = λ^|Z| det([E_Z, (λE − A)_R])
+///    for the zero columns Z and the rest R; with E_Z P = [Q1 Q2][R; 0] the remaining eigenvalues
+///    are those of (Q2ᵀE_R, Q2ᵀA_R)) and reported as EigenvalueKind::zero with α = 0, β = 1,
+///    error_bound 0. Throws SingularSystemError naming the states when E_Z is rank deficient
+///    (det(λE − A) ≡ 0, e.g. a column that is zero in both E and A).
+/// 2. The rest by LAPACK dggevx (permutation balancing; permutation and scaling as a fallback
+///    when no column was deflated, as QuadraticEigenSolver decides), with left and right
+///    eigenvectors, the backward error η = ‖(βA − αE)x‖/((|β|‖A‖ + |α|‖E‖)‖x‖) and the absolute
+///    condition κ = (‖A‖ + |λ|‖E‖)‖x‖‖y‖/|yᴴEx| (Higham & Higham 1998), error_bound =
+///    κ·max(η, η_floor) (+∞ when yᴴEx = 0), zero_within_bound when |λ| ≤ error_bound.
+///    An eigenvalue is infinite (kind infinite, λ = +∞, not counted for stability, error_bound 0,
+///    α and β as computed) when μ = β/α is zero within its own bound, the same test on the
+///    reversed pencil E − μA: |μ| ≤ (‖E‖ + |μ|‖A‖)‖x‖‖y‖/|yᴴAx|·max(η, η_floor). This includes
+///    β = 0 exactly (QZ sets β to 0 when it is below u‖E‖) and rounding-split Jordan chains at ∞.
+/// Norms are ‖·‖₂ lower estimates (so η errs on the large side). Cost: O(n³), about 66n³ flops
+/// for QZ with both eigenvector sets.
+class DescriptorEigenSolver {
+ public:
+  explicit DescriptorEigenSolver(DescriptorEigenOptions options = {});
+
+  /// Eigenpairs of the model's λE − A; the model's state names label SingularSystemError.
+  DescriptorEigenSolver& compute(const DescriptorModel& model);
+  /// Same for raw n×n matrices (validated as DescriptorModel does; states named "x1"..).
+  DescriptorEigenSolver& compute(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A);
+
+  /// Eigen::Success after a successful compute().
+  Eigen::ComputationInfo info() const { return info_; }
+  /// Eigenpairs sorted as QuadraticEigenSolver sorts them: zero kind first, then finite by
+  /// increasing |λ| (Im λ ≥ 0 first within a conjugate pair), then infinite. shape is the right
+  /// eigenvector x (n), (λE − A)x = 0; left_shape y, yᴴ(λE − A) = 0; both ‖·‖₂ = 1 with the
+  /// largest-modulus entry real positive. For the deflated zeros shape is exactly e_k and
+  /// left_shape the left null vector of A biorthogonal to them (yⱼᴴE e_k = 0 for j ≠ k); when no
+  /// such vectors exist (a Jordan chain at 0) they are marked defective.
+  const std::vector<Mode>& modes() const { return modes_; }
+  /// Number of exactly zero eigenvalues (deflated zero columns of A).
+  Eigen::Index num_zero() const { return num_zero_; }
+  /// Number of eigenvalues classified infinite (counted also when one_per_conjugate_pair).
+  Eigen::Index num_infinite() const { return num_infinite_; }
+  /// Stability verdict with the rules of QuadraticEigenSolver (see Stability).
+  Stability stability() const { return stability_; }
+  /// Largest backward error over all eigenpairs (the deflated zeros have 0).
+  double max_backward_error() const;
+  /// The state indices (0-based) of the deflated zero columns of A, in increasing order.
+  const std::vector<Eigen::Index>& zero_columns() const { return zero_columns_; }
+
+ private:
+  DescriptorEigenSolver& compute_named(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
+                                       const std::vector<std::string>& names);
+  void push_zero_modes(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
+                       const std::vector<Eigen::Index>& Z);
+
+  DescriptorEigenOptions options_;
+  Eigen::ComputationInfo info_ = Eigen::InvalidInput;
+  std::vector<Mode> modes_;
+  std::vector<Eigen::Index> zero_columns_;
+  Eigen::Index num_zero_ = 0, num_infinite_ = 0;
+  Stability stability_ = Stability::undecided;
+};
+
+/// Frequency response of a descriptor model for one input column.
+struct DescriptorFrf {
+  Eigen::VectorXd omega;       ///< F angular frequencies (rad/s), as given
+  Eigen::MatrixXcd response;   ///< p×F: row r is output outputs[r], column k frequency omega[k]
+  std::vector<FrfFlag> flags;  ///< F flags (FrfFlag)
+  Eigen::VectorXd rcond;       ///< F reciprocal 1-norm condition estimates of iΩE − A (zgecon)
+};
+
+/// ẑ(Ω) = (C (iΩE − A)⁻¹ B + D)(:, input) on the selected output rows (empty: all), for the
+/// frequencies omega (rad/s, finite, ≥ 0): for u = e_input cos(Ωt) the stationary output is
+/// z = Re(ẑ e^{iΩt}). Each frequency takes a complex LU with partial pivoting (LAPACK zgetrf) and
+/// Higham's 1-norm condition estimate (zgecon); a point is FrfFlag::pole when the LU meets an
+/// exactly zero pivot, rcond ≤ n·u or the result is not finite (response NaN, or
+/// SingularSystemError when on_pole == raise), ill_conditioned when rcond < 1e-8. Throws
+/// DimensionError for an input or output index out of range, NonFiniteError for a bad frequency.
+DescriptorFrf descriptor_frequency_response(const DescriptorModel& model,
+                                            const Eigen::VectorXd& omega, Eigen::Index input,
+                                            const std::vector<Eigen::Index>& outputs = {},
+                                            PoleHandling on_pole = PoleHandling::flag);
+
+}  // namespace mbsgen

@@ -1,0 +1,629 @@
+// Descriptor models E ẋ = A x + B u: validation, eigenpairs of λE − A, frequency response.
+//
+// Exact zeros. The generator writes structurally zero entries as exact 0.0, so an ignorable
+// coordinate x_k (one the equations never depend on) gives an exactly zero column k of A. Then
+// (λE − A)e_k = λE e_k, and for the set Z of such columns and the rest R,
+//     det(λE − A) = det([λE_Z, (λE − A)_R]) = λ^|Z| det([E_Z, (λE − A)_R]).
+// With the Householder QR E_Z P = [Q1 Q2][R; 0] (LAPACK dgeqp3, column pivoting for the rank
+// decision) the second factor is ±det(R)·det(Q2ᵀ(λE − A)_R), so the other eigenvalues are those
+// of the (n−|Z|)×(n−|Z|) pencil (Q2ᵀE_R, Q2ᵀA_R), computed without any rounding in the |Z|
+// zeros. If E_Z is rank deficient the second factor vanishes identically: the pencil is singular.
+// The test is done once: Z holds every exactly zero column of A, and after the orthogonal
+// transformation an exact 0.0 in Q2ᵀA_R is a floating-point accident, not a structural fact (nor
+// is a structural zero guaranteed to come out as 0.0), so repeating it would not be sound.
+// Eigenvectors of the full pencil from those w of the reduced one: right x = [x_Z; w] with
+// α R Pᵀx_Z = Q1ᵀ(βA_R − αE_R)w (the first |Z| rows of (βA − αE)x = 0), left y = Q2 l exactly
+// (Q2ᵀE_Z = 0 and A_Z = 0 make yᴴ(βA − αE) = 0).
+//
+// The rest: QZ with left and right eigenvectors (LAPACK dggevx; Moler & Stewart 1973). For the
+// pencil A − λE with data errors ‖ΔA‖ ≤ ε‖A‖, ‖ΔE‖ ≤ ε‖E‖ (Higham & Higham 1998, "Structured
+// backward error and condition of generalized eigenvalue problems", SIAM J. Matrix Anal. Appl.
+// 20(2), Thm. 3.1 and eq. 3.4 with the homogeneous backward error of Frayssé & Toumazou):
+//     η(α, β, x) = ‖(βA − αE)x‖ / ((|β|‖A‖ + |α|‖E‖)‖x‖),
+//     κ_abs(λ)   = (‖A‖ + |λ|‖E‖)‖x‖‖y‖ / |yᴴEx|,
+// and |λ − λ_exact| ≲ κ_abs·ε to first order. The homogeneous condition number of (α, β)
+// (Dedieu & Tisseur 2003, Thm. 4.2 for degree 1) is √(|α|²‖E‖² + |β|²‖A‖²)/|yᴴ(βE + ᾱA)x| for
+// unit x, y.
+#include "mbsgen/runtime/descriptor_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "lapack.hpp"
+
+namespace mbsgen {
+
+using cd = std::complex<double>;
+using Eigen::Index;
+
+namespace {
+constexpr double kU = std::numeric_limits<double>::epsilon() / 2;  // unit roundoff 2⁻⁵³
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+constexpr const char* kModel = "DescriptorModel";
+
+std::string dims(const Eigen::MatrixXd& M) {
+  std::ostringstream s;
+  s << M.rows() << "x" << M.cols();
+  return s.str();
+}
+
+void check_dims(const Eigen::MatrixXd& M, Index r, Index c, const char* name,
+                const char* expected) {
+  if (M.rows() != r || M.cols() != c) {
+    std::ostringstream s;
+    s << kModel << ": " << name << " is " << dims(M) << " but must be " << r << "x" << c << " ("
+      << expected << ")";
+    throw DimensionError(s.str());
+  }
+}
+
+void check_finite(const Eigen::MatrixXd& M, const char* name) {
+  for (Index j = 0; j < M.cols(); ++j)
+    for (Index i = 0; i < M.rows(); ++i)
+      if (!std::isfinite(M(i, j))) {
+        std::ostringstream s;
+        s << kModel << ": " << name << " (" << dims(M) << ") has a non-finite entry " << M(i, j)
+          << " at (" << i + 1 << "," << j + 1 << ")";
+        throw NonFiniteError(s.str());
+      }
+}
+
+std::vector<std::string> names_or_default(std::vector<std::string> names, Index n,
+                                          const char* prefix, const char* what) {
+  if (names.empty()) {
+    for (Index i = 0; i < n; ++i) names.push_back(prefix + std::to_string(i + 1));
+    return names;
+  }
+  if (static_cast<Index>(names.size()) != n) {
+    std::ostringstream s;
+    s << kModel << ": " << names.size() << " " << what << " given for " << n << " entries";
+    throw DimensionError(s.str());
+  }
+  return names;
+}
+
+std::vector<std::string> units_or_empty(std::vector<std::string> units, Index n,
+                                        const char* what) {
+  if (units.empty()) return std::vector<std::string>(static_cast<std::size_t>(n));
+  return names_or_default(std::move(units), n, "", what);
+}
+
+}  // namespace
+
+DescriptorModel::DescriptorModel(Eigen::MatrixXd E, Eigen::MatrixXd A, Eigen::MatrixXd B,
+                                 Eigen::MatrixXd C, Eigen::MatrixXd D,
+                                 std::vector<std::string> state_names,
+                                 std::vector<std::string> input_names,
+                                 std::vector<std::string> output_names,
+                                 std::vector<std::string> input_units,
+                                 std::vector<std::string> output_units)
+    : E_(std::move(E)), A_(std::move(A)), B_(std::move(B)), C_(std::move(C)), D_(std::move(D)) {
+  const Index n = E_.rows();
+  if (n == 0) throw DimensionError("DescriptorModel: E is 0x0; a model needs at least one state");
+  check_dims(E_, n, n, "E", "square");
+  check_dims(A_, n, n, "A", "same size as E");
+  if (B_.size() == 0) B_.resize(n, 0);
+  check_dims(B_, n, B_.cols(), "B", "n rows, one column per input");
+  if (C_.size() == 0) C_.resize(0, n);
+  check_dims(C_, C_.rows(), n, "C", "one column per state");
+  const Index m = B_.cols(), p = C_.rows();
+  if (D_.rows() == 0 && D_.cols() == 0) D_ = Eigen::MatrixXd::Zero(p, m);
+  check_dims(D_, p, m, "D", "p x m, one row per output, one column per input");
+  check_finite(E_, "E");
+  check_finite(A_, "A");
+  check_finite(B_, "B");
+  check_finite(C_, "C");
+  check_finite(D_, "D");
+  state_names_ = names_or_default(std::move(state_names), n, "x", "state names");
+  input_names_ = names_or_default(std::move(input_names), m, "u", "input names");
+  output_names_ = names_or_default(std::move(output_names), p, "z", "output names");
+  input_units_ = units_or_empty(std::move(input_units), m, "input units");
+  output_units_ = units_or_empty(std::move(output_units), p, "output units");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Eigenpairs.
+
+namespace {
+
+/// ‖x‖₂ = 1 and the largest-modulus entry real positive (as QuadraticEigenSolver).
+void normalize_shape(Eigen::VectorXcd& x) {
+  const double nx = x.norm();
+  if (nx == 0.0) return;
+  Index imax = 0;
+  x.cwiseAbs().maxCoeff(&imax);
+  const cd phase = std::abs(x[imax]) > 0 ? std::conj(x[imax]) / std::abs(x[imax]) : cd(1.0);
+  x *= phase / nx;
+  x[imax] = cd(x[imax].real(), 0.0);
+}
+
+/// Real A times complex X by two real products.
+Eigen::MatrixXcd times(const Eigen::Ref<const Eigen::MatrixXd>& A, const Eigen::MatrixXcd& X) {
+  Eigen::MatrixXcd out(A.rows(), X.cols());
+  const Eigen::MatrixXd Xr = X.real(), Xi = X.imag();
+  out.real().noalias() = A * Xr;
+  out.imag().noalias() = A * Xi;
+  return out;
+}
+
+/// A computed eigenpair of the full pencil, before classification.
+struct Raw {
+  cd alpha;     // normalized |α|² + β² = 1
+  double beta;  // ≥ 0
+  Eigen::VectorXcd x, y;
+  double eta = 0.0;
+};
+
+/// The deflation of the exactly zero columns Z of A (file comment).
+struct ZeroDeflation {
+  std::vector<Index> Z, R;  // zero columns of A, and the rest
+  Eigen::MatrixXd QR;       // dgeqp3 of E_Z: R in the upper triangle, reflectors below
+  Eigen::VectorXd tau;
+  std::vector<lapack_int> jpvt;  // E_Z P: column j of E_Z P is column jpvt[j] − 1 of E_Z
+  Eigen::MatrixXd E1, A1;        // Q1ᵀE_R, Q1ᵀA_R (|Z|×r)
+  Eigen::MatrixXd E2, A2;        // Q2ᵀE_R, Q2ᵀA_R (r×r): the reduced pencil
+  Eigen::MatrixXd Qfull;         // [Q1 Q2] (n×n), for the left eigenvectors y = Q2 l
+
+  void compute(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
+               const std::vector<std::string>& names);
+  /// Right eigenvector of the full pencil from w of the reduced one (file comment).
+  Eigen::VectorXcd right(const Eigen::VectorXcd& w, cd alpha, double beta) const;
+};
+
+void ZeroDeflation::compute(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
+                            const std::vector<std::string>& names) {
+  const Index n = A.rows();
+  Z.clear();
+  R.clear();
+  for (Index j = 0; j < n; ++j) ((A.col(j).array() == 0.0).all() ? Z : R).push_back(j);
+  const Index z = static_cast<Index>(Z.size()), r = n - z;
+  if (z == 0) {
+    E2 = E;
+    A2 = A;
+    return;
+  }
+  QR.resize(n, z);
+  Eigen::MatrixXd ER(n, r), AR(n, r);
+  for (Index j = 0; j < z; ++j) QR.col(j) = E.col(Z[static_cast<std::size_t>(j)]);
+  for (Index j = 0; j < r; ++j) {
+    ER.col(j) = E.col(R[static_cast<std::size_t>(j)]);
+    AR.col(j) = A.col(R[static_cast<std::size_t>(j)]);
+  }
+  // An exactly zero column in both E and A: the state does not enter the equations at all.
+  for (Index j = 0; j < z; ++j)
+    if ((QR.col(j).array() == 0.0).all()) {
+      std::ostringstream s;
+      s << "DescriptorEigenSolver::compute: the pencil λE − A is singular (det ≡ 0): state '"
+        << names[static_cast<std::size_t>(Z[static_cast<std::size_t>(j)])]
+        << "' has a zero column in both E and A (it appears in no equation)";
+      throw SingularSystemError(s.str());
+    }
+  const lapack_int nn = detail::li(n), zz = detail::li(z);
+  const char* who = "DescriptorEigenSolver::compute (zero deflation)";
+  jpvt.assign(static_cast<std::size_t>(z), 0);
+  tau.resize(z);
+  lapack_int info =
+      LAPACKE_dgeqp3(LAPACK_COL_MAJOR, nn, zz, QR.data(), nn, jpvt.data(), tau.data());
+  detail::check_lapack(info, "dgeqp3", who);
+  // Rank decision as QuadraticEigenSolver's default: pivot ≤ n·u·|R_00| counts as zero.
+  const double tol = static_cast<double>(n) * kU * std::abs(QR(0, 0));
+  for (Index j = 0; j < z; ++j)
+    if (!(std::abs(QR(j, j)) > tol)) {
+      std::ostringstream s;
+      s << "DescriptorEigenSolver::compute: the pencil λE − A is singular (det ≡ 0 to working "
+           "precision): the states with zero columns in A (";
+      for (Index k = 0; k < z; ++k)
+        s << (k ? ", " : "") << names[static_cast<std::size_t>(Z[static_cast<std::size_t>(k)])];
+      s << ") have linearly dependent columns in E (rank " << j << " of " << z << ")";
+      throw SingularSystemError(s.str());
+    }
+  Qfull = Eigen::MatrixXd::Identity(n, n);
+  for (Eigen::MatrixXd* X : {&ER, &AR, &Qfull}) {
+    info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', nn, detail::li(X->cols()), zz, QR.data(),
+                          nn, tau.data(), X->data(), nn);
+    detail::check_lapack(info, "dormqr", who);
+  }
+  Qfull.transposeInPlace();  // (Qᵀ I)ᵀ = Q
+  E1 = ER.topRows(z);
+  A1 = AR.topRows(z);
+  E2 = ER.bottomRows(r);
+  A2 = AR.bottomRows(r);
+}
+
+Eigen::VectorXcd ZeroDeflation::right(const Eigen::VectorXcd& w, cd alpha, double beta) const {
+  const Index z = static_cast<Index>(Z.size()), r = static_cast<Index>(R.size());
+  Eigen::VectorXcd x(z + r);
+  for (Index j = 0; j < r; ++j) x[R[static_cast<std::size_t>(j)]] = w[j];
+  if (z == 0) return x;
+  // α R Pᵀx_Z = (βA1 − αE1)w. α = 0 exactly (a further zero of the reduced pencil) has no
+  // solution unless the right side vanishes: a rounding-level α gives the chain's direction.
+  const cd a = alpha != 0.0 ? alpha : cd(kU);
+  const Eigen::VectorXcd rhs = (beta * times(A1, w) - alpha * times(E1, w)) / a;
+  const Eigen::MatrixXcd Rc = QR.topRows(z).cast<cd>();
+  const Eigen::VectorXcd v = Rc.triangularView<Eigen::Upper>().solve(rhs);
+  for (Index j = 0; j < z; ++j)
+    x[Z[static_cast<std::size_t>(jpvt[static_cast<std::size_t>(j)] - 1)]] = v[j];
+  return x;
+}
+
+/// Homogeneous backward error η of (α, β, x) for λE − A with norm estimates nE, nA.
+double backward_error(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A, cd alpha, double beta,
+                      const Eigen::VectorXcd& x, double nE, double nA) {
+  const double r = (beta * times(A, x) - alpha * times(E, x)).norm();
+  const double den = (beta * nA + std::abs(alpha) * nE) * x.norm();
+  if (den == 0.0) return r == 0.0 ? 0.0 : kInf;
+  return r / den;
+}
+
+/// QZ (dggevx, balancing `job`) of the reduced pencil (A2, E2), eigenvectors of the full pencil.
+std::vector<Raw> qz(const ZeroDeflation& d, const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
+                    char job, double nE, double nA) {
+  const Index m = d.A2.rows();
+  Eigen::MatrixXd As = d.A2, Es = d.E2, VL(m, m), VR(m, m);
+  Eigen::VectorXd ar(m), ai(m), be(m), lscale(m), rscale(m), rconde(m), rcondv(m);
+  lapack_int ilo = 0, ihi = 0;
+  double abnrm = 0, bbnrm = 0;
+  const lapack_int mm = detail::li(m);
+  const lapack_int info = LAPACKE_dggevx(
+      LAPACK_COL_MAJOR, job, 'V', 'V', 'N', mm, As.data(), mm, Es.data(), mm, ar.data(),
+      ai.data(), be.data(), VL.data(), mm, VR.data(), mm, &ilo, &ihi, lscale.data(),
+      rscale.data(), &abnrm, &bbnrm, rconde.data(), rcondv.data());
+  detail::check_lapack(info, "dggevx", "DescriptorEigenSolver::compute");
+  if (info > 0) throw LapackError("DescriptorEigenSolver::compute: QZ iteration (dggevx) failed");
+  const Index z = static_cast<Index>(d.Z.size());
+  std::vector<Raw> out;
+  out.reserve(static_cast<std::size_t>(m));
+  for (Index j = 0; j < m; ++j) {
+    Eigen::VectorXcd w(m), l(m);
+    if (ai[j] == 0.0) {
+      w = VR.col(j).cast<cd>();
+      l = VL.col(j).cast<cd>();
+    } else if (ai[j] > 0.0) {
+      w.real() = VR.col(j);
+      w.imag() = VR.col(j + 1);
+      l.real() = VL.col(j);
+      l.imag() = VL.col(j + 1);
+    } else {  // second of a pair: conjugate of the previous column pair
+      w.real() = VR.col(j - 1);
+      w.imag() = -VR.col(j);
+      l.real() = VL.col(j - 1);
+      l.imag() = -VL.col(j);
+    }
+    Raw r;
+    r.alpha = cd(ar[j], ai[j]);
+    r.beta = be[j];
+    const double s = std::hypot(std::abs(r.alpha), r.beta);
+    if (s > 0) {
+      r.alpha /= s;
+      r.beta /= s;
+    }
+    r.x = d.right(w, r.alpha, r.beta);
+    r.y = z > 0 ? Eigen::VectorXcd(times(d.Qfull.rightCols(m), l)) : l;
+    r.eta = backward_error(E, A, r.alpha, r.beta, r.x, nE, nA);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+double worst(const std::vector<Raw>& v) {
+  double e = 0.0;
+  for (const Raw& r : v) e = std::max(e, r.eta);
+  return e;
+}
+
+/// The verdict of Stability (quadratic_eigen.hpp) from the modes' error bounds; infinite
+/// eigenvalues do not count. The rules of QuadraticEigenSolver::stability().
+Stability stability_verdict(const std::vector<Mode>& modes) {
+  bool undecided = false, on_axis = false;
+  for (const Mode& m : modes) {
+    if (m.kind == EigenvalueKind::infinite) continue;
+    if (m.kind == EigenvalueKind::zero) {
+      on_axis = true;
+      continue;
+    }
+    const double re = m.lambda.real();
+    if (m.zero_within_bound || !(m.error_bound < kInf)) {
+      undecided = true;
+    } else if (re > m.error_bound) {
+      return Stability::unstable;
+    } else if (re == 0.0) {
+      on_axis = true;
+    } else if (re >= -m.error_bound) {
+      undecided = true;
+    }
+  }
+  if (undecided) return Stability::undecided;
+  return on_axis ? Stability::marginal : Stability::stable;
+}
+
+int kind_order(EigenvalueKind k) {
+  return k == EigenvalueKind::zero ? 0 : (k == EigenvalueKind::finite ? 1 : 2);
+}
+
+/// QuadraticEigenSolver's order: zero, finite by |λ| (Im λ > 0 first in a pair), infinite.
+void sort_modes(std::vector<Mode>& modes) {
+  std::stable_sort(modes.begin(), modes.end(), [](const Mode& a, const Mode& b) {
+    const int ka = kind_order(a.kind), kb = kind_order(b.kind);
+    if (ka != kb) return ka < kb;
+    if (a.kind != EigenvalueKind::finite) return false;
+    const double ra = std::abs(a.lambda), rb = std::abs(b.lambda);
+    if (ra != rb) return ra < rb;
+    return a.lambda.imag() > b.lambda.imag();
+  });
+  // Members of a conjugate pair can differ in |λ| by rounding: put Im λ > 0 first.
+  for (std::size_t k = 0; k + 1 < modes.size(); ++k) {
+    Mode& a = modes[k];
+    Mode& b = modes[k + 1];
+    if (a.kind != EigenvalueKind::finite || b.kind != EigenvalueKind::finite) continue;
+    const double ra = std::abs(a.lambda), rb = std::abs(b.lambda);
+    if (std::abs(ra - rb) <= 1e-8 * std::max(ra, rb) && a.lambda.imag() < 0 &&
+        b.lambda.imag() > 0 && std::abs(a.lambda - std::conj(b.lambda)) <= 1e-8 * ra) {
+      std::swap(a, b);
+      ++k;
+    }
+  }
+}
+
+/// Classifies a computed pair (class comment of DescriptorEigenSolver) and fills a Mode.
+Mode classify(Raw&& r, const Eigen::MatrixXd& E, const Eigen::MatrixXd& A, double nE, double nA,
+              double floor) {
+  Mode md;
+  md.alpha = r.alpha;
+  md.beta = r.beta;
+  md.backward_error = r.eta;
+  md.shape = std::move(r.x);
+  md.left_shape = std::move(r.y);
+  normalize_shape(md.shape);
+  normalize_shape(md.left_shape);
+  const Eigen::VectorXcd Ex = times(E, md.shape), Ax = times(A, md.shape);
+  const cd yEx = md.left_shape.dot(Ex), yAx = md.left_shape.dot(Ax);  // yᴴEx, yᴴAx
+  const double a = std::abs(md.alpha), b = md.beta;
+  const double eta = std::max(md.backward_error, floor);
+  {
+    const double num = std::sqrt(a * a * nE * nE + b * b * nA * nA);
+    const double den = std::abs(md.left_shape.dot(b * Ex + std::conj(md.alpha) * Ax));
+    md.condition_homogeneous = den > 0 ? num / den : kInf;
+  }
+  // Infinite within bound: the reversed pencil's μ = β/α is zero within its error bound
+  // (multiplied through by |α| so that α = 0 needs no case); only on the large side of the
+  // pencil's own scale |λ| = ‖A‖/‖E‖, so that a zero eigenvalue is never called infinite.
+  if (a * nE >= b * nA && b * std::abs(yAx) <= (a * nE + b * nA) * eta) {
+    md.kind = EigenvalueKind::infinite;
+    md.lambda = kInf;
+    md.natural_frequency_hz = kInf;
+    md.damped_frequency_hz = 0.0;
+    md.damping_ratio = 0.0;
+    md.condition = kInf;
+    md.error_bound = 0.0;
+    return md;
+  }
+  const cd lam = md.alpha / md.beta;
+  const double rl = std::abs(lam);
+  md.kind = EigenvalueKind::finite;
+  md.lambda = lam;
+  md.natural_frequency_hz = rl / kTwoPi;
+  md.damped_frequency_hz = lam.imag() / kTwoPi;
+  const double kappa_abs = std::abs(yEx) > 0 ? (nA + rl * nE) / std::abs(yEx) : kInf;
+  md.condition = rl > 0 ? kappa_abs / rl : kInf;
+  md.error_bound = kappa_abs < kInf ? kappa_abs * eta : kInf;
+  // A Jordan block at 0 split into ±√δ by rounding has yᴴEx = O(√δ): its bound exceeds |λ|.
+  md.zero_within_bound = !(rl > md.error_bound);
+  md.damping_ratio = (rl > 0 && !md.zero_within_bound) ? -lam.real() / rl + 0.0 : kNaN;
+  return md;
+}
+
+}  // namespace
+
+DescriptorEigenSolver::DescriptorEigenSolver(DescriptorEigenOptions options)
+    : options_(options) {}
+
+DescriptorEigenSolver& DescriptorEigenSolver::compute(const DescriptorModel& model) {
+  return compute_named(model.E(), model.A(), model.state_names());
+}
+
+DescriptorEigenSolver& DescriptorEigenSolver::compute(const Eigen::MatrixXd& E,
+                                                      const Eigen::MatrixXd& A) {
+  // Validates dimensions and finiteness (throws DimensionError / NonFiniteError).
+  const DescriptorModel check(E, A, Eigen::MatrixXd(E.rows(), 0), Eigen::MatrixXd(0, E.rows()));
+  return compute_named(E, A, check.state_names());
+}
+
+double DescriptorEigenSolver::max_backward_error() const {
+  double e = 0.0;
+  for (const Mode& m : modes_) e = std::max(e, m.backward_error);
+  return e;
+}
+
+DescriptorEigenSolver& DescriptorEigenSolver::compute_named(
+    const Eigen::MatrixXd& E, const Eigen::MatrixXd& A, const std::vector<std::string>& names) {
+  info_ = Eigen::InvalidInput;
+  modes_.clear();
+  num_zero_ = num_infinite_ = 0;
+  const Index n = E.rows();
+  const double nE = detail::norm2_estimate(E), nA = detail::norm2_estimate(A);
+  const double floor = options_.backward_error_floor > 0    ? options_.backward_error_floor
+                       : options_.backward_error_floor == 0 ? 100.0 * static_cast<double>(n) * kU
+                                                            : 0.0;
+  ZeroDeflation d;
+  d.compute(E, A, names);
+  zero_columns_ = d.Z;
+  const Index z = static_cast<Index>(d.Z.size());
+  num_zero_ = z;
+  if (z > 0) push_zero_modes(E, A, d.Z);
+
+  if (n > z) {
+    // Balancing as QuadraticEigenSolver: permutation only ('P'); permutation and scaling ('B',
+    // not normwise safe) only as a fallback when the largest backward error exceeds 10·n·u, and
+    // never after a deflation, whose rounding residue where A and E had exact zeros can steer
+    // the scaling astray.
+    std::vector<Raw> finite = qz(d, E, A, 'P', nE, nA);
+    if (z == 0 && worst(finite) > 10.0 * static_cast<double>(n) * kU) {
+      std::vector<Raw> alt = qz(d, E, A, 'B', nE, nA);
+      if (worst(alt) < worst(finite)) finite.swap(alt);
+    }
+    for (Raw& r : finite) {
+      Mode md = classify(std::move(r), E, A, nE, nA, floor);
+      if (md.kind == EigenvalueKind::infinite) ++num_infinite_;
+      if (options_.one_per_conjugate_pair && md.kind == EigenvalueKind::finite &&
+          md.lambda.imag() < 0.0)
+        continue;
+      modes_.push_back(std::move(md));
+    }
+  }
+  sort_modes(modes_);
+  stability_ = stability_verdict(modes_);
+  info_ = Eigen::Success;
+  return *this;
+}
+
+// The deflated zeros: x = e_k exactly; y from the left null space W of A (dimension |Z| when the
+// reduced pencil has no zero eigenvalue), made biorthogonal to them, Y = W (WᵀE_Z)⁻ᵀ, so that
+// y_jᵀE e_k = δ_jk before normalization. A numerically singular WᵀE_Z means a Jordan chain at 0
+// through the deflated directions: then W itself, and the modes are marked defective.
+void DescriptorEigenSolver::push_zero_modes(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
+                                            const std::vector<Index>& Z) {
+  const Index n = E.rows(), z = static_cast<Index>(Z.size());
+  const Eigen::MatrixXd W =
+      detail::null_space(A.transpose(), static_cast<double>(n) * kU, true, n - z).basis;
+  Eigen::MatrixXd EZ(n, z);
+  for (Index j = 0; j < z; ++j) EZ.col(j) = E.col(Z[static_cast<std::size_t>(j)]);
+  const Eigen::MatrixXd G = W.transpose() * EZ;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(G, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  const bool defective = !(sv[z - 1] > static_cast<double>(n) * kU * sv[0]);
+  const Eigen::MatrixXd Y =
+      defective ? W : Eigen::MatrixXd(W * svd.solve(Eigen::MatrixXd::Identity(z, z)).transpose());
+  const double nA = detail::norm2_estimate(A);
+  for (Index j = 0; j < z; ++j) {
+    Mode md;
+    md.kind = EigenvalueKind::zero;
+    md.lambda = 0.0;
+    md.alpha = 0.0;
+    md.beta = 1.0;
+    md.damping_ratio = kNaN;
+    md.shape = Eigen::VectorXcd::Unit(n, Z[static_cast<std::size_t>(j)]);
+    md.left_shape = Y.col(j).cast<cd>();
+    normalize_shape(md.left_shape);
+    md.defective = defective;
+    md.condition = kInf;
+    const Eigen::VectorXcd Ex = times(E, md.shape);
+    const double den = std::abs(md.left_shape.dot(Ex));  // |yᴴE e_k|
+    md.condition_homogeneous = (den > 0 && !defective) ? nA / den : kInf;
+    md.backward_error = 0.0;  // A e_k = 0 exactly
+    md.error_bound = 0.0;
+    modes_.push_back(std::move(md));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Frequency response.
+
+namespace {
+
+void check_frf_arguments(const DescriptorModel& model, const Eigen::VectorXd& omega,
+                         Index input, const std::vector<Index>& rows) {
+  const char* who = "descriptor_frequency_response";
+  if (input < 0 || input >= model.num_inputs()) {
+    std::ostringstream s;
+    s << who << ": input index " << input << " out of range (B is " << model.size() << "x"
+      << model.num_inputs() << ")";
+    throw DimensionError(s.str());
+  }
+  for (Index r : rows)
+    if (r < 0 || r >= model.num_outputs()) {
+      std::ostringstream s;
+      s << who << ": output index " << r << " out of range (C is " << model.num_outputs() << "x"
+        << model.size() << ")";
+      throw DimensionError(s.str());
+    }
+  for (Index k = 0; k < omega.size(); ++k)
+    if (!std::isfinite(omega[k]) || omega[k] < 0) {
+      std::ostringstream s;
+      s << who << ": frequency " << k << " is " << omega[k]
+        << " rad/s; frequencies must be finite and non-negative";
+      throw NonFiniteError(s.str());
+    }
+}
+
+}  // namespace
+
+DescriptorFrf descriptor_frequency_response(const DescriptorModel& model,
+                                            const Eigen::VectorXd& omega, Index input,
+                                            const std::vector<Index>& outputs,
+                                            PoleHandling on_pole) {
+  std::vector<Index> rows = outputs;
+  if (rows.empty())
+    for (Index i = 0; i < model.num_outputs(); ++i) rows.push_back(i);
+  check_frf_arguments(model, omega, input, rows);
+  const char* who = "descriptor_frequency_response";
+  const Index n = model.size(), p = static_cast<Index>(rows.size()), F = omega.size();
+  const Eigen::MatrixXd &E = model.E(), &A = model.A();
+  Eigen::MatrixXcd Cr(p, n);
+  Eigen::VectorXcd d(p);
+  for (Index r = 0; r < p; ++r) {
+    Cr.row(r) = model.C().row(rows[static_cast<std::size_t>(r)]).cast<cd>();
+    d[r] = model.D()(rows[static_cast<std::size_t>(r)], input);
+  }
+  DescriptorFrf out;
+  out.omega = omega;
+  out.response.resize(p, F);
+  out.rcond.resize(F);
+  out.flags.assign(static_cast<std::size_t>(F), FrfFlag::ok);
+  const double pole_rc = static_cast<double>(n) * kU;  // FrfOptions::pole_rcond's default
+  const double ill_rc = 1e-8;                          // FrfOptions::ill_conditioned_rcond's
+  const lapack_int nn = detail::li(n);
+  Eigen::MatrixXcd G(n, n);
+  Eigen::VectorXcd x(n), zwork(2 * n);
+  Eigen::VectorXd rwork(2 * n);
+  std::vector<lapack_int> ipiv(static_cast<std::size_t>(n));
+  for (Index k = 0; k < F; ++k) {
+    const double om = omega[k];
+    double anorm = 0.0;  // ‖iΩE − A‖₁ for zgecon
+    for (Index j = 0; j < n; ++j) {
+      double s = 0.0;
+      for (Index i = 0; i < n; ++i) {
+        G(i, j) = cd(-A(i, j), om * E(i, j));
+        s += std::abs(G(i, j));
+      }
+      anorm = std::max(anorm, s);
+    }
+    lapack_int info = LAPACKE_zgetrf_work(LAPACK_COL_MAJOR, nn, nn, G.data(), nn, ipiv.data());
+    detail::check_lapack(info, "zgetrf", who);
+    double rc = 0.0;
+    bool ok = info == 0;
+    if (ok) {
+      info = LAPACKE_zgecon_work(LAPACK_COL_MAJOR, '1', nn, G.data(), nn, anorm, &rc,
+                                 zwork.data(), rwork.data());
+      detail::check_lapack(info, "zgecon", who);
+      x = model.B().col(input).cast<cd>();
+      info = LAPACKE_zgetrs_work(LAPACK_COL_MAJOR, 'N', nn, 1, G.data(), nn, ipiv.data(),
+                                 x.data(), nn);
+      detail::check_lapack(info, "zgetrs", who);
+      out.response.col(k).noalias() = Cr * x;
+      out.response.col(k) += d;
+    }
+    out.rcond[k] = rc;
+    FrfFlag flag = FrfFlag::ok;
+    if (!ok || !(rc > pole_rc) || !out.response.col(k).allFinite())
+      flag = FrfFlag::pole;
+    else if (rc < ill_rc)
+      flag = FrfFlag::ill_conditioned;
+    out.flags[static_cast<std::size_t>(k)] = flag;
+    if (flag == FrfFlag::pole) {
+      if (on_pole == PoleHandling::raise) {
+        std::ostringstream s;
+        s << who << ": iΩE − A is singular at Ω = " << om << " rad/s, rcond = " << rc
+          << " (an eigenvalue on the imaginary axis at iΩ?)";
+        throw SingularSystemError(s.str());
+      }
+      out.response.col(k).setConstant(cd(kNaN, kNaN));
+    }
+  }
+  return out;
+}
+
+}  // namespace mbsgen
