@@ -75,20 +75,31 @@ struct DescriptorEigenOptions {
 /// 1. Exact zeros: every exactly zero column k of A (an ignorable coordinate) gives λ = 0 exactly,
 ///    eigenvector e_k. They are deflated orthogonally (det(λE − A) = λ^|Z| det([E_Z, (λE − A)_R])
 ///    for the zero columns Z and the rest R; with E_Z P = [Q1 Q2][R; 0] the remaining eigenvalues
-///    are those of (Q2ᵀE_R, Q2ᵀA_R)) and reported as EigenvalueKind::zero with α = 0, β = 1,
-///    error_bound 0. Throws SingularSystemError naming the states when E_Z is rank deficient
-///    (det(λE − A) ≡ 0, e.g. a column that is zero in both E and A).
-/// 2. The rest by LAPACK dggevx (permutation balancing; permutation and scaling as a fallback
-///    when no column was deflated, as QuadraticEigenSolver decides), with left and right
-///    eigenvectors, the backward error η = ‖(βA − αE)x‖/((|β|‖A‖ + |α|‖E‖)‖x‖) and the absolute
-///    condition κ = (‖A‖ + |λ|‖E‖)‖x‖‖y‖/|yᴴEx| (Higham & Higham 1998), error_bound =
-///    κ·max(η, η_floor) (+∞ when yᴴEx = 0), zero_within_bound when |λ| ≤ error_bound.
+///    are those of (Q2ᵀE_R, Q2ᵀA_R)) and reported as EigenvalueKind::zero with λ = 0, α = 0,
+///    β = 1, error_bound 0. When each column of E_Z has a single nonzero, in distinct rows (the
+///    usual E = blkdiag(I, M_r)), Q is a permutation: the reduced pencil is a submatrix bit for
+///    bit, and the test is repeated on it (soundly: a zero column there is exactly zero in the
+///    data outside the removed rows). Zeros found so are Jordan chains at 0 through the earlier
+///    ones (e.g. the lateral position y and yaw ψ of a rolling wheel with ẏ = vψ); their shape is
+///    the chain's head and both members are marked defective. Otherwise one Householder QR
+///    (LAPACK dgeqp3) deflates them, and the test is not repeated (after rounding an exact zero
+///    is no structural fact). Throws SingularSystemError naming the states when E_Z is rank
+///    deficient (det(λE − A) ≡ 0, e.g. a column that is zero in both E and A).
+/// 2. The rest by LAPACK dggevx with left and right eigenvectors. Balancing: permutation ('P');
+///    permutation and scaling ('B') when the largest normwise backward error exceeds 10·n·u
+///    (kept if smaller, QuadraticEigenSolver's rule) or the largest componentwise one does and
+///    'B' lowers it without raising the normwise one above 10·n·u — never after a Householder
+///    deflation. Each eigenvalue carries the backward error η = ‖(βA − αE)x‖/((|β|‖A‖ +
+///    |α|‖E‖)‖x‖) and the absolute condition κ = (‖A‖ + |λ|‖E‖)‖x‖‖y‖/|yᴴEx| (Higham & Higham
+///    1998), error_bound = κ·max(η, η_floor) (+∞ when yᴴEx = 0), zero_within_bound when
+///    |λ| ≤ error_bound, condition = κ/|λ|, condition_homogeneous (Dedieu & Tisseur 2003).
 ///    An eigenvalue is infinite (kind infinite, λ = +∞, not counted for stability, error_bound 0,
-///    α and β as computed) when μ = β/α is zero within its own bound, the same test on the
-///    reversed pencil E − μA: |μ| ≤ (‖E‖ + |μ|‖A‖)‖x‖‖y‖/|yᴴAx|·max(η, η_floor). This includes
-///    β = 0 exactly (QZ sets β to 0 when it is below u‖E‖) and rounding-split Jordan chains at ∞.
+///    α and β as computed) when |α|‖E‖ ≥ |β|‖A‖ and μ = β/α is zero within its own bound, the
+///    same test on the reversed pencil E − μA: |μ| ≤ (‖E‖ + |μ|‖A‖)‖x‖‖y‖/|yᴴAx|·max(η, η_floor).
+///    This includes β = 0 exactly (QZ sets β to 0 below u‖E‖) and rounding-split Jordan chains
+///    at ∞ (higher-index descriptor systems).
 /// Norms are ‖·‖₂ lower estimates (so η errs on the large side). Cost: O(n³), about 66n³ flops
-/// for QZ with both eigenvector sets.
+/// for QZ with both eigenvector sets, twice when 'B' is tried.
 class DescriptorEigenSolver {
  public:
   explicit DescriptorEigenSolver(DescriptorEigenOptions options = {});
@@ -103,11 +114,14 @@ class DescriptorEigenSolver {
   /// Eigenpairs sorted as QuadraticEigenSolver sorts them: zero kind first, then finite by
   /// increasing |λ| (Im λ ≥ 0 first within a conjugate pair), then infinite. shape is the right
   /// eigenvector x (n), (λE − A)x = 0; left_shape y, yᴴ(λE − A) = 0; both ‖·‖₂ = 1 with the
-  /// largest-modulus entry real positive. For the deflated zeros shape is exactly e_k and
-  /// left_shape the left null vector of A biorthogonal to them (yⱼᴴE e_k = 0 for j ≠ k); when no
-  /// such vectors exist (a Jordan chain at 0) they are marked defective.
+  /// largest-modulus entry real positive. For the deflated zeros, in increasing column order,
+  /// shape is exactly e_k (the chain's head for a defective one) and left_shape a left null
+  /// vector of A, biorthogonal to the other zeros' shapes (yⱼᴴE x_k = 0 for j ≠ k) when there is
+  /// no Jordan chain and that is well conditioned; otherwise an orthonormal basis vector of the
+  /// left null space, and condition_homogeneous is +∞.
   const std::vector<Mode>& modes() const { return modes_; }
-  /// Number of exactly zero eigenvalues (deflated zero columns of A).
+  /// Number of exactly zero eigenvalues (deflated zero columns of A and of the exactly reduced
+  /// pencils).
   Eigen::Index num_zero() const { return num_zero_; }
   /// Number of eigenvalues classified infinite (counted also when one_per_conjugate_pair).
   Eigen::Index num_infinite() const { return num_infinite_; }
@@ -115,14 +129,13 @@ class DescriptorEigenSolver {
   Stability stability() const { return stability_; }
   /// Largest backward error over all eigenpairs (the deflated zeros have 0).
   double max_backward_error() const;
-  /// The state indices (0-based) of the deflated zero columns of A, in increasing order.
+  /// The state indices (0-based) of the deflated zero columns, in increasing order (the order
+  /// of the zero modes).
   const std::vector<Eigen::Index>& zero_columns() const { return zero_columns_; }
 
  private:
   DescriptorEigenSolver& compute_named(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
                                        const std::vector<std::string>& names);
-  void push_zero_modes(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
-                       const std::vector<Eigen::Index>& Z);
 
   DescriptorEigenOptions options_;
   Eigen::ComputationInfo info_ = Eigen::InvalidInput;
