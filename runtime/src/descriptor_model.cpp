@@ -190,10 +190,16 @@ struct HouseholderDeflation {
   }
 };
 
-[[noreturn]] void throw_unused_state(const std::string& name) {
+/// `level` > 0: the column is zero in the equations left after deflating ignorable coordinates.
+[[noreturn]] void throw_unused_state(const std::string& name, int level = 0) {
   std::ostringstream s;
   s << "DescriptorEigenSolver::compute: the pencil λE − A is singular (det ≡ 0): state '" << name
-    << "' has a zero column in both E and A (it appears in no equation)";
+    << "' has a zero column in both E and A ";
+  if (level == 0)
+    s << "(it appears in no equation)";
+  else
+    s << "in the equations left after deflating the ignorable coordinates (it appears only in "
+         "theirs)";
   throw SingularSystemError(s.str());
 }
 
@@ -323,7 +329,7 @@ void Deflation::compute(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
           ++count;
           p = r;
         }
-      if (count == 0) throw_unused_state(names[static_cast<std::size_t>(c)]);
+      if (count == 0) throw_unused_state(names[static_cast<std::size_t>(c)], levels);
       if (count > 1 || row_used[static_cast<std::size_t>(p)]) structured = false;
       if (count == 1) row_used[static_cast<std::size_t>(p)] = 1;
       level.push_back({c, p, levels});
@@ -439,6 +445,11 @@ std::vector<Raw> qz(const Deflation& d, const Eigen::MatrixXd& E, const Eigen::M
       l.real() = VL.col(j - 1);
       l.imag() = -VL.col(j);
     }
+    if (ar[j] == 0.0 && ai[j] == 0.0 && be[j] == 0.0)  // dggevx's sign of a singular pencil
+      throw SingularSystemError(
+          "DescriptorEigenSolver::compute: the pencil λE − A is singular (det ≡ 0 to working "
+          "precision: QZ found α = β = 0), e.g. equations that are linearly dependent in both E "
+          "and A");
     Raw r;
     r.alpha = cd(ar[j], ai[j]);
     r.beta = be[j];
