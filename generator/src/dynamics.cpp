@@ -295,6 +295,7 @@ Equations derive(const Model& model, const DeriveOptions& options) {
   eq.loops = close_loops(model, eq);
   if (has_reactions(model)) reaction_outputs(eq, probes);
   reduce_equations(eq);
+  eq.nonholonomic = nonholonomic_constraints(model, eq);
   return eq;
 }
 

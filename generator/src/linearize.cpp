@@ -102,23 +102,12 @@ Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operat
 
 }  // namespace
 
-LinearEquations linearize(Equations& eq) {
+// The tree's M, Q, K, B, C_y, C_v (and C_a, D) at the operating point, reduced to the
+// independent coordinates when the loops are closed (at rest).
+void linearize_tree(Equations& eq, LinearEquations& lin, std::size_t f) {  // f = n here
   const Model& model = *eq.model;
   Program& prog = eq.program;
-  LinearEquations lin;
-  std::size_t f = eq.y.size();
   const std::size_t m = eq.u.size(), r = eq.outputs.size();
-
-  const OperatingPoint& op = model.operating_point();
-  lin.equilibrium = op.kind == OperatingPoint::Kind::equilibrium;
-  for (const auto& c : model.coordinates()) {
-    auto p = op.position.find(c.name);
-    lin.y0.push_back(p == op.position.end() ? ex(0) : p->second);
-    auto v = op.velocity.find(c.name);
-    lin.yd0.push_back(v == op.velocity.end() ? ex(0) : v->second);
-    if (!lin.yd0.back().is_zero()) lin.at_rest = false;
-  }
-
   // The operating point has u = 0 and, at rest, ẏ = 0: substituted through the program so that
   // every term that vanishes there (gyroscopic, centrifugal, damping forces) drops out. A scene
   // (apply_scene) also fixes the rates its steady motion sets to zero (a spinning rotor's tilt
@@ -171,9 +160,42 @@ LinearEquations linearize(Equations& eq) {
   if (loops) {
     reduce_linear(eq, residual_at_rest, lin.M, lin.Q, lin.K, lin.B, lin.Cy, lin.Cv);
     Ca = reduce_columns(eq, Ca);
-    f = eq.loops.independent.size();
     lin.coordinates = eq.loops.independent;
   }
+  // C_a and D_u: kept only when some entry can be nonzero.
+  bool any = false;
+  for (const ExMatrix* A : {&Ca, &Du})
+    for (const auto& row : *A)
+      for (const auto& x : row) any = any || !x.is_zero();
+  if (any) lin.Ca = Ca, lin.Du = Du;
+}
+
+LinearEquations linearize(Equations& eq) {
+  const Model& model = *eq.model;
+  LinearEquations lin;
+  std::size_t f = eq.y.size();
+
+  const OperatingPoint& op = model.operating_point();
+  lin.equilibrium = op.kind == OperatingPoint::Kind::equilibrium;
+  for (const auto& c : model.coordinates()) {
+    auto p = op.position.find(c.name);
+    lin.y0.push_back(p == op.position.end() ? ex(0) : p->second);
+    auto v = op.velocity.find(c.name);
+    lin.yd0.push_back(v == op.velocity.end() ? ex(0) : v->second);
+    if (!lin.yd0.back().is_zero()) lin.at_rest = false;
+  }
+
+  if (eq.nonholonomic.active || (eq.loops.active && !lin.at_rest)) {
+    // Rolling wheels, or closed loops in steady motion (nonholonomic.hpp).
+    linearize_constrained(eq, lin);
+    if (lin.descriptor) {
+      lin.zeros = find_structural_zeros(eq, lin);
+      return lin;
+    }
+  } else {
+    linearize_tree(eq, lin, f);
+  }
+  f = lin.coordinates.size();
   auto split = [&](const ExMatrix& A, ExMatrix& S, ExMatrix& W) {
     S.assign(f, std::vector<ex>(f, 0));
     W.assign(f, std::vector<ex>(f, 0));
@@ -209,12 +231,6 @@ LinearEquations linearize(Equations& eq) {
       }
       if (st.N_zero) lin.K[i][j] = lin.K[j][i];
     }
-  // C_a and D_u: kept only when some entry can be nonzero.
-  bool any = false;
-  for (const ExMatrix* A : {&Ca, &Du})
-    for (const auto& row : *A)
-      for (const auto& x : row) any = any || !x.is_zero();
-  if (any) lin.Ca = Ca, lin.Du = Du;
   split(lin.Q, lin.D, lin.G);
   split(lin.K, lin.Ks, lin.N);
   lin.zeros = find_structural_zeros(eq, lin);

@@ -3,6 +3,7 @@
 #include "mbsgen/generator/dynamics.hpp"
 #include "mbsgen/generator/structural_zeros.hpp"
 
+#include "pivoting.hpp"
 #include "point_evaluator.hpp"
 
 #include <Eigen/Dense>
@@ -46,6 +47,12 @@ std::vector<RawEquation> equations_of(const Model& model, Program& prog, const K
     add("", c.expression, false);
     return out;
   }
+  if (c.kind == ConstraintKind::rolling) {  // the wheel touches the ground (nonholonomic.hpp)
+    const RollingGeometry g = rolling_geometry(model, prog, kin, c);
+    size2 = prog.define(dot(g.centre, g.centre) + c.length * c.length);
+    add("height", g.height, true);
+    return out;
+  }
   const Vec3 ra = kin.marker_position(model, prog, c.marker_a), rb = kin.marker_position(model, prog, c.marker_b);
   const Mat3 Sa = kin.marker_frame(model, prog, c.marker_a), Sb = kin.marker_frame(model, prog, c.marker_b);
   const Vec3 d = sub(rb, ra);
@@ -72,6 +79,7 @@ std::vector<RawEquation> equations_of(const Model& model, Program& prog, const K
       add("length", (dot(d, d) - c.length * c.length) / (2 * c.length), true);
       break;
     case ConstraintKind::expression:
+    case ConstraintKind::rolling:
       break;
   }
   return out;
@@ -240,14 +248,7 @@ void check_closure(const Model& model, const std::vector<RawEquation>& raw, cons
 
 // ---------------------------------------------------------------------------------------------
 // The split into independent and dependent coordinates.
-std::vector<std::size_t> qr_choice(const MatrixXd& J) {
-  Eigen::ColPivHouseholderQR<MatrixXd> qr(J);
-  std::vector<std::size_t> dependent;
-  for (Eigen::Index i = 0; i < J.rows(); ++i)
-    dependent.push_back(static_cast<std::size_t>(qr.colsPermutation().indices()(i)));
-  std::sort(dependent.begin(), dependent.end());
-  return dependent;
-}
+std::vector<std::size_t> qr_choice(const MatrixXd& J) { return pivoted_qr_columns(J); }
 
 MatrixXd columns(const MatrixXd& J, const std::vector<std::size_t>& which) {
   MatrixXd A(J.rows(), static_cast<Eigen::Index>(which.size()));
@@ -297,42 +298,6 @@ void choose_coordinates(const Model& model, const MatrixXd& J, LoopClosure& loop
     if (!std::binary_search(dependent.begin(), dependent.end(), j)) loops.independent.push_back(j);
 }
 
-// Row order of partial pivoting of Φ_yd at the operating point.
-std::vector<std::size_t> pivot_rows(MatrixXd A) {
-  const Eigen::Index m = A.rows();
-  std::vector<std::size_t> rows(static_cast<std::size_t>(m));
-  for (Eigen::Index i = 0; i < m; ++i) rows[static_cast<std::size_t>(i)] = static_cast<std::size_t>(i);
-  for (Eigen::Index k = 0; k < m; ++k) {
-    Eigen::Index p = k;
-    for (Eigen::Index i = k + 1; i < m; ++i)
-      if (std::abs(A(i, k)) > std::abs(A(p, k))) p = i;
-    A.row(k).swap(A.row(p));
-    std::swap(rows[static_cast<std::size_t>(k)], rows[static_cast<std::size_t>(p)]);
-    for (Eigen::Index i = k + 1; i < m; ++i) A.row(i) -= A(i, k) / A(k, k) * A.row(k);
-  }
-  return rows;
-}
-
-// P Φ_yd = L U with program expressions (exact zeros skipped).
-void factor(Program& prog, LoopClosure& loops) {
-  const std::size_t m = loops.dependent.size();
-  loops.L.assign(m, std::vector<ex>(m, 0));
-  loops.U.assign(m, std::vector<ex>(m, 0));
-  for (std::size_t i = 0; i < m; ++i) {
-    loops.L[i][i] = 1;
-    for (std::size_t j = 0; j < m; ++j) loops.U[i][j] = loops.Phi_y[loops.rows[i]][loops.dependent[j]];
-  }
-  for (std::size_t k = 0; k < m; ++k)
-    for (std::size_t i = k + 1; i < m; ++i) {
-      if (loops.U[i][k].is_zero()) continue;
-      const ex l = prog.define(loops.U[i][k] / loops.U[k][k]);
-      loops.L[i][k] = l;
-      for (std::size_t j = k + 1; j < m; ++j)
-        if (!loops.U[k][j].is_zero()) loops.U[i][j] = prog.define(loops.U[i][j] - l * loops.U[k][j]);
-      loops.U[i][k] = 0;
-    }
-}
-
 // A double as an exact rational (so that it does not lower the precision of 50-digit floats).
 GiNaC::numeric exact(double x) {
   int e = 0;
@@ -375,7 +340,52 @@ std::vector<ConstraintEquation> constraint_equations(const Model& model, Program
   return out;
 }
 
-std::vector<ex> LoopClosure::solve(Program& prog, const std::vector<ex>& b) const {
+std::vector<std::size_t> partial_pivoting_rows(MatrixXd A) {
+  const Eigen::Index m = A.rows();
+  std::vector<std::size_t> rows(static_cast<std::size_t>(m));
+  for (Eigen::Index i = 0; i < m; ++i) rows[static_cast<std::size_t>(i)] = static_cast<std::size_t>(i);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    Eigen::Index p = k;
+    for (Eigen::Index i = k + 1; i < m; ++i)
+      if (std::abs(A(i, k)) > std::abs(A(p, k))) p = i;
+    A.row(k).swap(A.row(p));
+    std::swap(rows[static_cast<std::size_t>(k)], rows[static_cast<std::size_t>(p)]);
+    for (Eigen::Index i = k + 1; i < m; ++i) A.row(i) -= A(i, k) / A(k, k) * A.row(k);
+  }
+  return rows;
+}
+
+std::vector<std::size_t> pivoted_qr_columns(const MatrixXd& J) {
+  Eigen::ColPivHouseholderQR<MatrixXd> qr(J);
+  std::vector<std::size_t> picked;
+  for (Eigen::Index i = 0; i < qr.rank(); ++i) picked.push_back(static_cast<std::size_t>(qr.colsPermutation().indices()(i)));
+  std::sort(picked.begin(), picked.end());
+  return picked;
+}
+
+SymbolicLU SymbolicLU::factor(Program& prog, const ExMatrix& A, std::vector<std::size_t> rows) {
+  const std::size_t m = A.size();
+  SymbolicLU lu;
+  lu.rows = std::move(rows);
+  lu.L.assign(m, std::vector<ex>(m, 0));
+  lu.U.assign(m, std::vector<ex>(m, 0));
+  for (std::size_t i = 0; i < m; ++i) {
+    lu.L[i][i] = 1;
+    for (std::size_t j = 0; j < m; ++j) lu.U[i][j] = A[lu.rows[i]][j];
+  }
+  for (std::size_t k = 0; k < m; ++k)
+    for (std::size_t i = k + 1; i < m; ++i) {
+      if (lu.U[i][k].is_zero()) continue;
+      const ex l = prog.define(lu.U[i][k] / lu.U[k][k]);
+      lu.L[i][k] = l;
+      for (std::size_t j = k + 1; j < m; ++j)
+        if (!lu.U[k][j].is_zero()) lu.U[i][j] = prog.define(lu.U[i][j] - l * lu.U[k][j]);
+      lu.U[i][k] = 0;
+    }
+  return lu;
+}
+
+std::vector<ex> SymbolicLU::solve(Program& prog, const std::vector<ex>& b) const {
   const std::size_t m = rows.size();
   std::vector<ex> z(m);
   for (std::size_t i = 0; i < m; ++i) {  // L z = P b
@@ -394,7 +404,7 @@ std::vector<ex> LoopClosure::solve(Program& prog, const std::vector<ex>& b) cons
   return x;
 }
 
-std::vector<ex> LoopClosure::solve_transposed(Program& prog, const std::vector<ex>& b) const {
+std::vector<ex> SymbolicLU::solve_transposed(Program& prog, const std::vector<ex>& b) const {
   const std::size_t m = rows.size();
   std::vector<ex> w(m);
   for (std::size_t i = 0; i < m; ++i) {  // Uᵀ w = b
@@ -415,6 +425,12 @@ std::vector<ex> LoopClosure::solve_transposed(Program& prog, const std::vector<e
   return lambda;
 }
 
+std::vector<ex> LoopClosure::solve(Program& prog, const std::vector<ex>& b) const { return lu.solve(prog, b); }
+
+std::vector<ex> LoopClosure::solve_transposed(Program& prog, const std::vector<ex>& b) const {
+  return lu.solve_transposed(prog, b);
+}
+
 LoopClosure close_loops(const Model& model, Equations& eq) {
   LoopClosure loops;
   if (model.constraints().empty()) return loops;
@@ -430,6 +446,12 @@ LoopClosure close_loops(const Model& model, Equations& eq) {
       else
         raw.push_back(std::move(r));
     }
+  bool only_rolling = true;
+  for (const auto& c : model.constraints()) only_rolling = only_rolling && c.kind == ConstraintKind::rolling;
+  if (raw.empty() && only_rolling) {  // wheels whose contact the coordinates keep (a rolling disk)
+    loops.active = false;
+    return loops;
+  }
   if (raw.empty())
     throw ModelError(model.constraints().front().where,
                      "every constraint equation is identically satisfied: the constraints do not restrict the motion");
@@ -457,8 +479,10 @@ LoopClosure close_loops(const Model& model, Equations& eq) {
   loops.Phi_y = Phi_y;
   choose_coordinates(model, J, loops);
   loops.closed_at_defaults = refine(model, eq, raw, Phi_y, loops.dependent);
-  loops.rows = pivot_rows(columns(J, loops.dependent));
-  factor(prog, loops);
+  ExMatrix Phi_yd(loops.dependent.size(), std::vector<ex>(loops.dependent.size(), 0));
+  for (std::size_t k = 0; k < Phi_yd.size(); ++k)
+    for (std::size_t d = 0; d < loops.dependent.size(); ++d) Phi_yd[k][d] = Phi_y[k][loops.dependent[d]];
+  loops.lu = SymbolicLU::factor(prog, Phi_yd, partial_pivoting_rows(columns(J, loops.dependent)));
 
   // X = −Φ_yd⁻¹ Φ_yi, column by column; g_d = −Φ_yd⁻¹ γ with γ = (∂(Φ_y ẏ)/∂y) ẏ.
   const std::size_t fi = loops.independent.size(), m = loops.dependent.size();

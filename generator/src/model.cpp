@@ -73,6 +73,7 @@ const char* to_string(ConstraintKind kind) {
     case ConstraintKind::planar: return "planar";
     case ConstraintKind::distance: return "distance";
     case ConstraintKind::expression: return "expression";
+    case ConstraintKind::rolling: return "rolling";
   }
   return "";
 }
@@ -195,6 +196,18 @@ void Model::add_output(Output output) {
 void Model::add_constraint(Constraint constraint) {
   check_new_element(constraint.name, "constraint", constraint.where);
   constraints_.push_back(std::move(constraint));
+}
+
+void Model::add_velocity_constraint(VelocityConstraint constraint) {
+  check_new_element(constraint.name, "nonholonomic constraint", constraint.where);
+  velocity_constraints_.push_back(std::move(constraint));
+}
+
+bool Model::nonholonomic() const {
+  if (!velocity_constraints_.empty()) return true;
+  for (const auto& c : constraints_)
+    if (c.kind == ConstraintKind::rolling) return true;
+  return false;
 }
 
 void Model::add_scene(Scene scene) {
@@ -423,6 +436,10 @@ void Model::validate_constraints(const GiNaC::exmap& defaults) const {
         throw ModelError(c.where, who + " does not depend on any coordinate");
       continue;
     }
+    if (c.kind == ConstraintKind::rolling) {
+      validate_rolling(c, who, defaults, parameters_only);
+      continue;
+    }
     for (const std::string* m : {&c.marker_a, &c.marker_b})
       if (!has_marker(*m)) throw ModelError(c.where, who + " names an unknown marker '" + *m + "'");
     if (marker(c.marker_a).body == marker(c.marker_b).body)
@@ -447,11 +464,69 @@ void Model::validate_constraints(const GiNaC::exmap& defaults) const {
     if (!independent.insert(item.name).second)
       throw ModelError(item.where, "independent coordinate '" + item.name + "' is listed twice");
   }
-  if (!constraints_.empty())
-    for (const auto& [name, value] : operating_point_.velocity)
-      if (!value.is_zero())
-        throw ModelError(operating_point_.where, "a model with constraints is linearized at rest; the steady rate of '" +
-                                                     name + "' must be 0 (steady motions of closed loops are not supported)");
+}
+
+// A rolling wheel: its marker on a body (not the world), a positive radius, a unit ground normal.
+void Model::validate_rolling(const Constraint& c, const std::string& who, const GiNaC::exmap& defaults,
+                             const std::set<std::string>& parameters_only) const {
+  if (!has_marker(c.marker_a)) throw ModelError(c.where, who + " names an unknown marker '" + c.marker_a + "'");
+  if (marker(c.marker_a).body == kWorld)
+    throw ModelError(c.where, who + ": wheel marker '" + c.marker_a + "' is on the world; it must be on the wheel body");
+  check_symbols(c.length, c.where, "a wheel radius", parameters_only);
+  bool ok = false;
+  const double r = numeric_value(c.length, defaults, ok);
+  if (!ok || !(r > 0))
+    throw ModelError(c.where, who + " needs a positive radius (" +
+                                  (ok ? detail::checked_subs_impl::describe(GiNaC::numeric(r)) + " m"
+                                      : std::string("not a number")) + " with the default parameter values)");
+  double norm2 = 0;
+  for (const auto& x : c.normal) {
+    check_symbols(x, c.where, "a ground normal", {});
+    bool exact = false;
+    const double v = numeric_value(x, defaults, exact);
+    norm2 += exact ? v * v : std::nan("");
+  }
+  const double norm = std::sqrt(norm2);
+  if (!(std::abs(norm - 1) <= 1e-12))
+    throw ModelError(c.where, who + ": the ground normal must be a unit vector (its length is " +
+                                  detail::checked_subs_impl::describe(GiNaC::numeric(norm)) + ")");
+}
+
+// Nonholonomic constraints: expressions in coordinates, rates and parameters, linear in the
+// rates and depending on one; independent speeds name coordinates once each; a steady motion or
+// rest given, not an equilibrium to be found (an equilibrium search does not know the constraints).
+void Model::validate_velocity_constraints() const {
+  std::set<std::string> allowed = symbol_names(true);
+  for (const auto& y : coordinates_) allowed.insert(y.name + "_dot");
+  for (const auto& v : velocity_constraints_) {
+    check_symbols(v.expression, v.where, "a nonholonomic constraint", allowed);
+    bool depends = false;
+    for (const auto& y : coordinates_) depends = depends || v.expression.has(y.velocity);
+    if (!depends)
+      throw ModelError(v.where, "nonholonomic constraint '" + v.name +
+                                    "' does not depend on any rate (a constraint on positions belongs in 'constraints')");
+    for (const auto& a : coordinates_)
+      for (const auto& b : coordinates_)
+        if (!v.expression.diff(a.velocity).diff(b.velocity).expand().is_zero())
+          throw ModelError(v.where, "nonholonomic constraint '" + v.name + "' is not linear in the rates (it has a term in " +
+                                        a.name + "_dot*" + b.name + "_dot)");
+  }
+  std::set<std::string> listed;
+  for (const auto& item : independent_speeds_) {
+    if (!nonholonomic())
+      throw ModelError(item.where, "independent speeds are chosen only in a model with nonholonomic constraints");
+    if (coordinate_index(item.name) < 0)
+      throw ModelError(item.where, "independent speed '" + item.name + "' is not a coordinate (name the coordinate whose rate it is)");
+    if (!listed.insert(item.name).second)
+      throw ModelError(item.where, "independent speed '" + item.name + "' is listed twice");
+  }
+  for (const auto& o : outputs_)
+    if (o.kind == OutputKind::reaction && nonholonomic())
+      throw ModelError(o.where, "output '" + o.name + "': reaction outputs are not available in a model with "
+                                "nonholonomic constraints (rolling wheels) yet");
+  if (nonholonomic() && operating_point_.kind == OperatingPoint::Kind::equilibrium)
+    throw ModelError(operating_point_.where, "a model with nonholonomic constraints is linearized at a given operating point "
+                                             "(rest or a steady motion), not at an equilibrium to be found");
 }
 
 void Model::validate() const {
@@ -581,6 +656,7 @@ void Model::validate() const {
     }
   }
   validate_constraints(defaults);
+  validate_velocity_constraints();
   for (const auto& [name, value] : operating_point_.position) {
     if (coordinate_index(name) < 0)
       throw ModelError(operating_point_.where, "operating point names an unknown coordinate '" + name + "'");

@@ -176,6 +176,7 @@ Load constraint_load(const Model& model, Equations& eq, const Constraint& c, con
       break;
     }
     case ConstraintKind::expression:
+    case ConstraintKind::rolling:  // refused by Model::validate_velocity_constraints
       break;
   }
   return load;

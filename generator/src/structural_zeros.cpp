@@ -25,7 +25,8 @@ struct Target {
 
 std::vector<Target> targets(LinearEquations& lin, StructuralZeros& z) {
   return {{&lin.M, &z.M},   {&lin.Q, &z.Q}, {&lin.K, &z.K}, {&lin.B, &z.B},   {&lin.Cy, &z.Cy},
-          {&lin.Cv, &z.Cv}, {&lin.D, &z.D}, {&lin.G, &z.G}, {&lin.Ks, &z.Ks}, {&lin.N, &z.N}};
+          {&lin.Cv, &z.Cv}, {&lin.D, &z.D}, {&lin.G, &z.G}, {&lin.Ks, &z.Ks}, {&lin.N, &z.N},
+          {&lin.E, &z.E},   {&lin.A, &z.A}, {&lin.Bx, &z.Bx}, {&lin.Cx, &z.Cx}};
 }
 
 // ---------------------------------------------------------------------------------------------

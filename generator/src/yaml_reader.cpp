@@ -862,6 +862,8 @@ class Reader {
   void read_output(const YAML::Node& n);
   void read_load_output(const YAML::Node& n, const std::string& type, const Fields& f, Output& o);
   void read_constraint(const YAML::Node& n, std::map<std::string, int>& counters);
+  void read_rolling(const Fields& f, const YAML::Node& n, Constraint& c);
+  void read_velocity_constraints(const Entry* e);
   void read_operating_point(const Entry& e);
   OperatingPointOverride read_operating_point_values(const YAML::Node& n, const std::string& what);
   void read_scene(const YAML::Node& n);
@@ -931,7 +933,8 @@ Model Reader::read_model() {
                                     "'model: NAME')");
   const Fields top = fields(root, "the model file",
                             {"model", "parameters", "coordinates", "inputs", "bodies", "markers",
-                             "forces", "constraints", "independent_coordinates", "outputs",
+                             "forces", "constraints", "independent_coordinates", "nonholonomic",
+                             "independent_speeds", "outputs",
                              "operating_point", "scenes"});
 
   const Entry& name_entry = require(top, "model", root, "the model file");
@@ -980,6 +983,14 @@ Model Reader::read_model() {
       if (model.coordinate_index(item.name) < 0)
         throw ModelError(item.where, "independent coordinate '" + item.name + "' is not a coordinate");
     model.set_independent_coordinates(std::move(names));
+  }
+  read_velocity_constraints(find(top, "nonholonomic"));
+  if (const Entry* e = find(top, "independent_speeds")) {
+    std::vector<SceneItem> names = items(*e, "independent_speeds");
+    for (const auto& item : names)
+      if (model.coordinate_index(item.name) < 0)
+        throw ModelError(item.where, "independent speed '" + item.name + "' is not a coordinate (name the coordinate whose rate it is)");
+    model.set_independent_speeds(std::move(names));
   }
   for (const auto& o : outputs) read_output(o);
 
@@ -1367,7 +1378,7 @@ void Reader::read_load_output(const YAML::Node& n, const std::string& type, cons
 // length, or an expression Φ(y) = 0.
 void Reader::read_constraint(const YAML::Node& n, std::map<std::string, int>& counters) {
   static const std::vector<std::string> types = {"spherical", "revolute", "prismatic", "planar", "distance",
-                                                 "expression"};
+                                                 "expression", "rolling"};
   if (!n.IsMap()) fail(n, "expected a map for a constraint, got " + describe(n));
   const YAML::Node type_node = n["type"];
   if (!type_node) fail(n, "a constraint needs the key 'type' (one of: " + join(types) + ")");
@@ -1378,6 +1389,7 @@ void Reader::read_constraint(const YAML::Node& n, std::map<std::string, int>& co
   }
   std::vector<std::string> keys = {"type", "name"};
   if (type == "expression") keys.push_back("expression");
+  else if (type == "rolling") keys.insert(keys.end(), {"wheel", "radius", "axis", "normal"});
   else keys.push_back("between");
   if (type == "distance") keys.push_back("length");
   const std::string what = "a " + type + " constraint";
@@ -1395,9 +1407,12 @@ void Reader::read_constraint(const YAML::Node& n, std::map<std::string, int>& co
   static const std::map<std::string, ConstraintKind> kinds = {
       {"spherical", ConstraintKind::spherical}, {"revolute", ConstraintKind::revolute},
       {"prismatic", ConstraintKind::prismatic}, {"planar", ConstraintKind::planar},
-      {"distance", ConstraintKind::distance},   {"expression", ConstraintKind::expression}};
+      {"distance", ConstraintKind::distance},   {"expression", ConstraintKind::expression},
+      {"rolling", ConstraintKind::rolling}};
   c.kind = kinds.at(type);
-  if (type == "expression") {
+  if (type == "rolling") {
+    read_rolling(f, n, c);
+  } else if (type == "expression") {
     c.expression = expr(require(f, "expression", n, what), "a constraint expression", Scope::positions);
   } else {
     const YAML::Node& bn = value(require(f, "between", n, what));
@@ -1410,6 +1425,46 @@ void Reader::read_constraint(const YAML::Node& n, std::map<std::string, int>& co
   }
   if (type == "distance") c.length = expr(require(f, "length", n, what), "a rod length", Scope::parameters);
   model_->add_constraint(c);
+}
+
+// A wheel rolling on the ground: `wheel` (a marker at its centre, on the wheel body), `radius`,
+// `axis` (the marker's axis along the axle: x, y or z; default z) and the ground's unit `normal`
+// (numbers, world frame; default [0, 0, 1]).
+void Reader::read_rolling(const Fields& f, const YAML::Node& n, Constraint& c) {
+  const std::string what = "a rolling constraint";
+  c.marker_a = check_marker(value(require(f, "wheel", n, what)));
+  c.length = expr(require(f, "radius", n, what), "a wheel radius", Scope::parameters);
+  if (const Entry* a = find(f, "axis")) {
+    const std::string axis = scalar(value(*a), "a wheel axis");
+    if (axis != "x" && axis != "y" && axis != "z")
+      fail(value(*a), "a wheel's axis is the wheel marker's x, y or z axis, got '" + axis + "'");
+    c.axis = axis[0] - 'x';
+  }
+  if (const Entry* e = find(f, "normal")) c.normal = vec3(*e, "a ground normal", Scope::constants);
+}
+
+// `nonholonomic:` velocity constraints, expressions linear in the rates (model.hpp,
+// VelocityConstraint): `- {name: N, expression: E}` or `- E` (named nonholonomic1, ...).
+void Reader::read_velocity_constraints(const Entry* e) {
+  int k = 0;
+  for (const auto& n : list(e, "nonholonomic")) {
+    VelocityConstraint v;
+    v.where = element_loc(n);
+    if (n.IsMap()) {
+      const Fields f = fields(n, "a nonholonomic constraint", {"name", "expression"});
+      if (const Entry* ne = find(f, "name")) v.name = name(*ne, "a constraint name");
+      v.expression = expr(require(f, "expression", n, "a nonholonomic constraint"), "a nonholonomic constraint",
+                          Scope::no_inputs);
+    } else {
+      v.expression = expr(n, "a nonholonomic constraint", Scope::no_inputs);
+    }
+    if (v.name.empty()) {
+      do v.name = "nonholonomic" + std::to_string(++k);
+      while (used_names_.count(v.name));
+    }
+    used_names_.insert(v.name);
+    model_->add_velocity_constraint(v);
+  }
 }
 
 void Reader::read_operating_point(const Entry& e) {

@@ -10,7 +10,7 @@
 // stiffness matrix of a conservative element exactly symmetric.
 #pragma once
 
-#include "mbsgen/generator/loop_closure.hpp"
+#include "mbsgen/generator/nonholonomic.hpp"
 
 #include <vector>
 
@@ -32,6 +32,8 @@ struct Equations {
   /// those of the independent coordinates (f = n − m columns; the residual and outputs take the
   /// rates of the independent coordinates), and `tree` keeps the tree's (n columns).
   LoopClosure loops;
+  /// Nonholonomic constraints (nonholonomic.hpp), built after the loops.
+  Nonholonomic nonholonomic;
   struct Tree {
     ExMatrix M, JT, JR;
     std::vector<GiNaC::ex> residual, outputs;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "mbsgen/generator/dynamics.hpp"
+#include "mbsgen/generator/nonholonomic.hpp"
 #include "mbsgen/generator/structural_zeros.hpp"
 
 namespace mbsgen {
@@ -21,6 +22,14 @@ struct LinearEquations {
   /// The model's coordinates (indices) that the linear model and the kernels use: all of them,
   /// or the independent ones of a model with closed loops (loop_closure.hpp).
   std::vector<std::size_t> coordinates;
+  /// Nonholonomic constraints (nonholonomic.hpp): the coordinates whose rates are the
+  /// independent speeds w (all of `coordinates` without such constraints).
+  std::vector<std::size_t> speeds;
+  /// True for a model with nonholonomic constraints: its linear model is the descriptor system
+  ///   E ẋ = A x + Bx u,  z = Cx x,  x = (δy_i, δw)  (f + s states),
+  /// and M, Q, K, B, C_y, C_v above are empty.
+  bool descriptor = false;
+  ExMatrix E, A, Bx, Cx;
   ExMatrix M, Q, K, B, Cy, Cv;  ///< f×f, f×f, f×f, f×m, r×f, r×f (expressions in y, ẏ, p)
   ExMatrix D, G, Ks, N;         ///< sym Q, skew Q, sym K, skew K
   /// Outputs that depend on accelerations and inputs (reaction forces, reactions.hpp):

@@ -38,6 +38,19 @@ struct ConstraintEquation {
   double scale = 1;
 };
 
+/// A square matrix of program expressions factored as P A = L U (Gaussian elimination with the
+/// row order `rows` that partial pivoting chooses at the operating point, exact zeros skipped),
+/// for solving with it symbolically: the loops' Φ_yd, the nonholonomic constraints' speed block.
+struct SymbolicLU {
+  std::vector<std::size_t> rows;
+  ExMatrix L, U;
+  /// Factors A (k×k) with the given row order.
+  static SymbolicLU factor(Program& program, const ExMatrix& A, std::vector<std::size_t> rows);
+  /// A⁻¹ b and A⁻ᵀ b (program expressions).
+  std::vector<GiNaC::ex> solve(Program& program, const std::vector<GiNaC::ex>& b) const;
+  std::vector<GiNaC::ex> solve_transposed(Program& program, const std::vector<GiNaC::ex>& b) const;
+};
+
 struct LoopClosure {
   bool active = false;  ///< the model has constraints
   std::vector<ConstraintEquation> equations;  ///< the m equations kept
@@ -59,9 +72,7 @@ struct LoopClosure {
   std::vector<GiNaC::ex> solve(Program& program, const std::vector<GiNaC::ex>& b) const;
   std::vector<GiNaC::ex> solve_transposed(Program& program, const std::vector<GiNaC::ex>& b) const;
 
-  // The LU factors P Φ_yd = L U (row permutation `rows`), program expressions.
-  std::vector<std::size_t> rows;
-  ExMatrix L, U;
+  SymbolicLU lu;  ///< P Φ_yd = L U
 };
 
 /// Every equation of the model's constraints (none dropped), written with the kinematics `kin`.

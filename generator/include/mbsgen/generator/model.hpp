@@ -169,20 +169,38 @@ struct Input {
 ///   distance   (d·d − L²)/(2L) = 0                               (1: a massless rigid rod of length L)
 ///   expression Φ = expression                                   (1: any expression in coordinates
 ///                                                                and parameters)
+///   rolling    ((n·C)² − r² |n × a|²)/(2r) = 0                   (1: a thin disk touches the ground)
+/// A rolling constraint is a thin disk (wheel) of radius r rolling without slipping on the ground
+/// plane n·x = 0 (n the unit normal, pointing from the ground to the wheel; world frame): marker a
+/// sits at the wheel's centre C on the wheel body, and its `axis` (x, y or z) is the wheel's axle
+/// a. The contact point is P = C − r (n − (n·a) a)/|n × a|; besides the holonomic contact
+/// condition above, the nonholonomic stage (nonholonomic.hpp) adds the two no-slip conditions
+/// t·v_P = 0 along the ground (v_P the velocity of the wheel's material point at P).
 /// The joint equations are scaled so that their multipliers λ are the reaction forces [N] and
 /// torques [N m] in the world frame. Equations that vanish identically (a 3-D joint in a planar
 /// model) are dropped.
-enum class ConstraintKind { spherical, revolute, prismatic, planar, distance, expression };
+enum class ConstraintKind { spherical, revolute, prismatic, planar, distance, expression, rolling };
 
-/// "spherical", "revolute", "prismatic", "planar", "distance", "expression".
+/// "spherical", "revolute", "prismatic", "planar", "distance", "expression", "rolling".
 const char* to_string(ConstraintKind kind);
 
 struct Constraint {
   std::string name;
   ConstraintKind kind = ConstraintKind::spherical;
   std::string marker_a, marker_b;  ///< every kind but expression
-  GiNaC::ex length;                ///< distance: L [m] (> 0)
+  GiNaC::ex length;                ///< distance: L [m] (> 0); rolling: the wheel radius r [m]
   GiNaC::ex expression;            ///< expression: Φ (in coordinates and parameters)
+  int axis = 2;                    ///< rolling: the axle is marker a's x (0), y (1) or z (2) axis
+  Vec3 normal = {0, 0, 1};         ///< rolling: the ground's unit normal (world frame, constants)
+  SourceLocation where;
+};
+
+/// A nonholonomic constraint A(y) ẏ + a(y) = 0 (docs/model-format.md, "nonholonomic"): one
+/// expression in coordinates, rates and parameters, linear in the rates, that the motion keeps at
+/// zero (a velocity that no choice of coordinates removes, such as a skate's sideways speed).
+struct VelocityConstraint {
+  std::string name;
+  GiNaC::ex expression;
   SourceLocation where;
 };
 
@@ -374,6 +392,11 @@ class Model {
   /// constraints); when not set, the generator chooses them by pivoted QR of the constraint
   /// Jacobian at the operating point (loop_closure.hpp).
   void set_independent_coordinates(std::vector<SceneItem> names) { independent_ = std::move(names); }
+  /// A nonholonomic constraint (validate() checks that it is linear in the rates).
+  void add_velocity_constraint(VelocityConstraint constraint);
+  /// The rates that stay independent speeds with nonholonomic constraints (the rest follow from
+  /// the constraints); when not set, chosen by pivoted QR at the operating point (nonholonomic.hpp).
+  void set_independent_speeds(std::vector<SceneItem> names) { independent_speeds_ = std::move(names); }
   void set_operating_point(OperatingPoint op) { operating_point_ = std::move(op); }
   /// Adds a scene; its references are checked by validate().
   void add_scene(Scene scene);
@@ -410,6 +433,11 @@ class Model {
   const std::vector<Output>& outputs() const { return outputs_; }
   const std::vector<Constraint>& constraints() const { return constraints_; }
   const std::vector<SceneItem>& independent_coordinates() const { return independent_; }
+  const std::vector<VelocityConstraint>& velocity_constraints() const { return velocity_constraints_; }
+  const std::vector<SceneItem>& independent_speeds() const { return independent_speeds_; }
+  /// True when the motion has nonholonomic constraints (velocity constraints or rolling wheels):
+  /// the linear model is then first order, E ẋ = A x + B u (nonholonomic.hpp).
+  bool nonholonomic() const;
   const OperatingPoint& operating_point() const { return operating_point_; }
   const std::vector<Scene>& scenes() const { return scenes_; }
   /// The scene of that name, or nullptr (also for the implicit "full").
@@ -447,6 +475,9 @@ class Model {
   static void check_symbols(const GiNaC::ex& e, const SourceLocation& where, const std::string& what,
                             const std::set<std::string>& allowed);
   void validate_constraints(const GiNaC::exmap& defaults) const;
+  void validate_velocity_constraints() const;
+  void validate_rolling(const Constraint& c, const std::string& who, const GiNaC::exmap& defaults,
+                        const std::set<std::string>& parameters_only) const;
 
   std::string name_;
   GiNaC::symtab symtab_;
@@ -465,6 +496,8 @@ class Model {
   std::vector<Output> outputs_;
   std::vector<Constraint> constraints_;
   std::vector<SceneItem> independent_;
+  std::vector<VelocityConstraint> velocity_constraints_;
+  std::vector<SceneItem> independent_speeds_;
   OperatingPoint operating_point_;
   std::vector<Scene> scenes_;
   bool inertial_velocity_terms_ = true;

@@ -42,6 +42,7 @@ using ZeroPattern = std::vector<std::vector<EntryZero>>;
 struct StructuralZeros {
   /// Patterns of M, Q, K, B, C_y, C_v, D, G, K_s, N (sizes as the matrices).
   ZeroPattern M, Q, K, B, Cy, Cv, D, G, Ks, N;
+  ZeroPattern E, A, Bx, Cx;  ///< the descriptor matrices of a nonholonomic model
   std::size_t everywhere = 0;           ///< entries proved zero for all kernel arguments
   std::size_t at_operating_point = 0;   ///< entries proved zero at the operating point only
   std::size_t unproved = 0;             ///< numerically zero candidates not proved (kept)

@@ -1,0 +1,80 @@
+// Stage 2c: nonholonomic constraints (rolling wheels, skates) and the linear model of a
+// constrained steady motion (docs/generator.md, "Rolling contact and steady motions").
+//
+// Velocity constraints A(y) ẏ + a(y) = 0 (m of them, model.hpp VelocityConstraint, and two per
+// rolling wheel: the contact point's velocity along the ground is zero) cannot be integrated into
+// constraints on positions: the coordinates keep their number, the speeds do not. After the
+// loops (loop_closure.hpp: ẏ = T ẏ_i), the rates of the independent coordinates split into
+// independent speeds w (s of them) and dependent ones with B = A T regular in the latter:
+//   ẏ_i = N w + n,   N = [E; −B_d⁻¹ B_s],   n = [0; −B_d⁻¹ a].
+// The equations of motion are the tree's projected with (T N)ᵀ, which removes the loops'
+// multipliers λ and the constraint forces Aᵀμ (d'Alembert–Lagrange for nonholonomic systems).
+//
+// Linearized about a steady motion (y0, ẏ0): constant rates, ÿ0 = 0, and equations, constraints
+// and T independent of the coordinates whose rates are not zero (a bicycle's position, heading
+// and wheel angles), the state x = (δy_i, δw) obeys the first-order (descriptor) system
+//   δẏ_i = P δy_i + N δw,        P = [0; −B_d⁻¹ A_q T],  A_q = ∂(A ẏ + a)/∂y at ẏ0,
+//   M_r δẇ + C_r δw + K_r δy_i = B_r δu,
+//   M_r = (TN)ᵀ M T N,  C_r = (TN)ᵀ (M T P + H_v T) N,
+//   K_r = (TN)ᵀ [(H_y − G) T + (M T P + H_v T) P],  B_r = (TN)ᵀ B,
+// with H_y = ∂h/∂y and H_v = ∂h/∂ẏ of the tree's residual h = k − q at the steady motion, and
+// G = Σ λ_k ∂²Φ_k/∂y² + Σ μ_k ∂A_kᵀ/∂y the geometric stiffness of the constraint forces there
+// (λ, μ from h(y0, ẏ0) = Φ_yᵀ λ + Aᵀ μ; ../shared/reference/constraints.md). Without
+// nonholonomic constraints N = E and P = 0: the second-order model of a closed loop in steady
+// motion. References: Neimark & Fufaev, Dynamics of Nonholonomic Systems (1972), ch. III;
+// Peterson, Gede & Hubbard, Multibody Syst Dyn 33 (2015) (SymPy's Linearizer, whose state is
+// the same (q_i, u_i)).
+#pragma once
+
+#include "mbsgen/generator/loop_closure.hpp"
+
+#include <string>
+#include <vector>
+
+namespace mbsgen {
+
+struct Equations;
+struct LinearEquations;
+
+/// A rolling wheel's geometry (model.hpp, ConstraintKind::rolling), world frame: centre C, axle
+/// a, ground normal n, the contact point's offset d = P − C = −r (n − (n·a) a)/|n × a| and the
+/// contact condition n·C = r |n × a|, written Φ = ((n·C)² − r² |n × a|²)/(2r) (program expressions).
+struct RollingGeometry {
+  Vec3 centre, axle, normal, offset;
+  GiNaC::ex height;
+};
+RollingGeometry rolling_geometry(const Model& model, Program& program, const Kinematics& kin, const Constraint& c);
+
+/// One scalar velocity constraint: value = A_k(y) ẏ + a_k(y).
+struct VelocityEquation {
+  std::string constraint;  ///< the model's name (a velocity or rolling constraint)
+  std::string component;   ///< rolling: "t1", "t2" (the ground's tangent directions); else ""
+  GiNaC::ex value;
+};
+
+struct Nonholonomic {
+  bool active = false;
+  std::vector<VelocityEquation> equations;  ///< m
+  ExMatrix A;                               ///< m×n (tree coordinates)
+  std::vector<GiNaC::ex> a;                 ///< m
+  /// Coordinate indices (ascending) whose rates are the independent speeds w, and those whose
+  /// rates follow from the constraints; together the independent coordinates of the loops.
+  std::vector<std::size_t> speeds, dependent_speeds;
+  bool chosen = false;  ///< speeds chosen by mbsgen (not listed in the model)
+  SymbolicLU lu;        ///< of B_d = (A T)_d
+};
+
+/// Builds the velocity constraints of a derived model (after close_loops), chooses or checks the
+/// independent speeds at the operating point with the default parameter values, and checks that
+/// the operating point's rates satisfy the constraints. Inactive without such constraints.
+/// Throws ModelError for dependent rates the model gives inconsistently, singular constraints.
+Nonholonomic nonholonomic_constraints(const Model& model, Equations& eq);
+
+/// The linear model of a constrained steady motion (the formulas above) into lin: for a model
+/// with nonholonomic constraints the descriptor matrices (lin.descriptor), otherwise the
+/// second-order M, Q, K, B, C_y, C_v of the independent coordinates. Throws ModelError when the
+/// operating point is not a steady motion (residual, or equations that depend on a coordinate
+/// whose rate is not zero).
+void linearize_constrained(Equations& eq, LinearEquations& lin);
+
+}  // namespace mbsgen

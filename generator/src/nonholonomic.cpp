@@ -1,0 +1,598 @@
+#include "mbsgen/generator/nonholonomic.hpp"
+
+#include "mbsgen/generator/dynamics.hpp"
+#include "mbsgen/generator/linearize.hpp"
+
+#include "pivoting.hpp"
+#include "point_evaluator.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+namespace mbsgen {
+
+using Eigen::MatrixXd;
+using GiNaC::ex;
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Matrices of program expressions (exact zeros skipped, each entry an intermediate).
+
+ExMatrix zeros(std::size_t rows, std::size_t cols) { return ExMatrix(rows, std::vector<ex>(cols, 0)); }
+
+std::size_t columns_of(const ExMatrix& A) { return A.empty() ? 0 : A[0].size(); }
+
+ExMatrix product(Program& prog, const ExMatrix& A, const ExMatrix& B) {
+  const std::size_t inner = B.size(), cols = columns_of(B);
+  ExMatrix R = zeros(A.size(), cols);
+  for (std::size_t i = 0; i < A.size(); ++i)
+    for (std::size_t j = 0; j < cols; ++j) {
+      ex s = 0;
+      for (std::size_t k = 0; k < inner; ++k)
+        if (!A[i][k].is_zero() && !B[k][j].is_zero()) s += A[i][k] * B[k][j];
+      R[i][j] = prog.define(s);
+    }
+  return R;
+}
+
+ExMatrix transposed(const ExMatrix& A) {
+  ExMatrix R = zeros(columns_of(A), A.size());
+  for (std::size_t i = 0; i < A.size(); ++i)
+    for (std::size_t j = 0; j < A[i].size(); ++j) R[j][i] = A[i][j];
+  return R;
+}
+
+ExMatrix combination(Program& prog, const ExMatrix& A, const ExMatrix& B, int sign) {
+  ExMatrix R = A;
+  for (std::size_t i = 0; i < A.size(); ++i)
+    for (std::size_t j = 0; j < A[i].size(); ++j)
+      if (!B[i][j].is_zero()) R[i][j] = prog.define(A[i][j] + sign * B[i][j]);
+  return R;
+}
+
+// The independent coordinates of the loops (all coordinates without loops).
+std::vector<std::size_t> independent_coordinates(const Equations& eq) {
+  if (eq.loops.active) return eq.loops.independent;
+  std::vector<std::size_t> all(eq.y.size());
+  for (std::size_t k = 0; k < all.size(); ++k) all[k] = k;
+  return all;
+}
+
+// T = ∂y/∂y_i (n×f): unit rows for the independent coordinates, X for the dependent ones.
+ExMatrix tangent_map(const Equations& eq) {
+  const std::vector<std::size_t> indep = independent_coordinates(eq);
+  ExMatrix T = zeros(eq.y.size(), indep.size());
+  for (std::size_t j = 0; j < indep.size(); ++j) T[indep[j]][j] = 1;
+  if (eq.loops.active)
+    for (std::size_t d = 0; d < eq.loops.dependent.size(); ++d) T[eq.loops.dependent[d]] = eq.loops.X[d];
+  return T;
+}
+
+std::size_t position_in(const std::vector<std::size_t>& v, std::size_t k) {
+  return static_cast<std::size_t>(std::lower_bound(v.begin(), v.end(), k) - v.begin());
+}
+
+std::string coordinate_names(const Model& model, const std::vector<std::size_t>& which) {
+  std::string s;
+  for (std::size_t k : which) s += (s.empty() ? "" : ", ") + model.coordinates()[k].name;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Numbers at the operating point with the default parameter values (50 digits; the loops'
+// dependent coordinates closed by close_loops).
+
+GiNaC::exmap defaults_at_operating_point(const Model& model, const Equations& eq) {
+  GiNaC::exmap p, values;
+  for (std::size_t k = 0; k < eq.p.size(); ++k) p[eq.p[k]] = GiNaC::numeric(model.parameters()[k].value);
+  values = p;
+  const OperatingPoint& op = model.operating_point();
+  for (std::size_t k = 0; k < eq.y.size(); ++k) {
+    const auto& name = model.coordinates()[k].name;
+    auto closed = eq.loops.closed_at_defaults.find(eq.y[k]);
+    auto given = op.position.find(name);
+    values[eq.y[k]] = closed != eq.loops.closed_at_defaults.end() ? closed->second
+                      : given != op.position.end()                  ? given->second.subs(p)
+                                                                    : ex(0);
+    auto rate = op.velocity.find(name);
+    values[eq.yd[k]] = rate != op.velocity.end() ? rate->second.subs(p) : ex(0);
+  }
+  return values;
+}
+
+// `shift` moves coordinates away from the operating point (index → amount).
+std::vector<double> at_defaults(const Model& model, Equations& eq, const std::vector<ex>& entries,
+                                const std::map<std::size_t, double>& shift = {}) {
+  const long digits = GiNaC::Digits;
+  GiNaC::Digits = detail::PointEvaluator::kDigits;
+  std::vector<GiNaC::numeric> v;
+  try {
+    GiNaC::exmap point = defaults_at_operating_point(model, eq);
+    for (const auto& [k, amount] : shift) point[eq.y[k]] = point[eq.y[k]] + GiNaC::numeric(amount);
+    v = detail::PointEvaluator(eq.program, point).evaluate(entries);
+  } catch (const std::exception& e) {
+    GiNaC::Digits = digits;
+    throw ModelError(model.operating_point().where, std::string("the velocity constraints cannot be evaluated at the "
+                                                                "operating point with the default parameter values (") +
+                                                        e.what() + ")");
+  }
+  GiNaC::Digits = digits;
+  std::vector<double> out;
+  for (const auto& x : v) out.push_back(x.is_real() ? x.to_double() : std::nan(""));
+  return out;
+}
+
+MatrixXd numbers(const Model& model, Equations& eq, const ExMatrix& A) {
+  std::vector<ex> entries;
+  for (const auto& row : A) entries.insert(entries.end(), row.begin(), row.end());
+  const std::vector<double> v = at_defaults(model, eq, entries);
+  MatrixXd R(static_cast<Eigen::Index>(A.size()), static_cast<Eigen::Index>(columns_of(A)));
+  for (Eigen::Index i = 0; i < R.rows(); ++i)
+    for (Eigen::Index j = 0; j < R.cols(); ++j) R(i, j) = v[static_cast<std::size_t>(i * R.cols() + j)];
+  return R;
+}
+
+// The largest steady rate with the default parameter values.
+double rate_size(const Model& model, const Equations& eq) {
+  const GiNaC::exmap at = defaults_at_operating_point(model, eq);
+  double size = 0;
+  for (const auto& s : eq.yd) size = std::max(size, std::abs(GiNaC::ex_to<GiNaC::numeric>(at.at(s).evalf()).to_double()));
+  return size;
+}
+
+std::string format(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Rolling wheels
+
+RollingGeometry rolling_geometry(const Model& model, Program& prog, const Kinematics& kin, const Constraint& c) {
+  RollingGeometry g;
+  g.centre = kin.marker_position(model, prog, c.marker_a);
+  const Mat3 S = kin.marker_frame(model, prog, c.marker_a);
+  for (int i = 0; i < 3; ++i) g.axle[i] = S[i][c.axis];
+  g.normal = c.normal;
+  const ex s = prog.define(dot(g.normal, g.axle));
+  const ex w = prog.define(GiNaC::sqrt(1 - s * s));  // |n × a| = cos(lean): 1 upright
+  // n·C = r |n × a| squared, so that no square root enters the holonomic condition (a model
+  // whose coordinates keep the wheel on the ground then has Φ ≡ 0, proved and dropped);
+  // divided by 2r to keep the size of a length (the gradient is that of n·C upright).
+  const ex h = prog.define(dot(g.normal, g.centre));
+  g.height = prog.define((h * h - c.length * c.length * (1 - s * s)) / (2 * c.length));
+  g.offset = define(prog, scale(-c.length / w, sub(g.normal, scale(s, g.axle))));
+  return g;
+}
+
+namespace {
+
+// Two orthonormal directions of the ground plane: t1 = (e_k × n)/|e_k × n| with e_k the world
+// axis least aligned with n, t2 = n × t1 (exact for a normal along a world axis).
+std::pair<Vec3, Vec3> ground_tangents(const Vec3& n) {
+  int k = 0;
+  double least = 2;
+  for (int i = 0; i < 3; ++i) {
+    const double v = std::abs(GiNaC::ex_to<GiNaC::numeric>(n[i].evalf()).to_double());
+    if (v < least) least = v, k = i;
+  }
+  Vec3 e = {0, 0, 0};
+  e[k] = 1;
+  const Vec3 c = cross(e, n);
+  const ex norm = GiNaC::sqrt(dot(c, c).expand());
+  const Vec3 t1 = {(c[0] / norm).normal(), (c[1] / norm).normal(), (c[2] / norm).normal()};
+  const Vec3 t2 = cross(n, t1);
+  return {t1, {t2[0].expand(), t2[1].expand(), t2[2].expand()}};
+}
+
+std::vector<VelocityEquation> velocity_equations(const Model& model, Equations& eq) {
+  Program& prog = eq.program;
+  const Kinematics& kin = eq.kinematics;
+  std::vector<VelocityEquation> out;
+  for (const auto& c : model.constraints()) {
+    if (c.kind != ConstraintKind::rolling) continue;
+    // The wheel's material point at the contact has v_P = v_C + ω × (P − C) = 0 along the ground.
+    const RollingGeometry g = rolling_geometry(model, prog, kin, c);
+    const Vec3 vP = add(kin.marker_velocity(model, prog, c.marker_a),
+                        cross(kin.marker_angular_velocity(model, c.marker_a), g.offset));
+    const auto [t1, t2] = ground_tangents(c.normal);
+    out.push_back({c.name, "t1", prog.define(dot(t1, vP))});
+    out.push_back({c.name, "t2", prog.define(dot(t2, vP))});
+  }
+  for (const auto& v : model.velocity_constraints()) out.push_back({v.name, "", prog.define(v.expression)});
+  return out;
+}
+
+const SourceLocation& where_of(const Model& model, const std::string& name) {
+  for (const auto& c : model.constraints())
+    if (c.name == name) return c.where;
+  for (const auto& v : model.velocity_constraints())
+    if (v.name == name) return v.where;
+  return model.operating_point().where;
+}
+
+// The dependent speeds (positions in the independent coordinates): listed, or chosen by pivoted
+// QR of B = A T at the operating point.
+std::vector<std::size_t> choose_dependent_speeds(const Model& model, const std::vector<std::size_t>& indep,
+                                                 const MatrixXd& B, Nonholonomic& nh) {
+  const std::size_t m = static_cast<std::size_t>(B.rows()), f = indep.size();
+  Eigen::ColPivHouseholderQR<MatrixXd> qr(B);
+  qr.setThreshold(1e-10);
+  if (static_cast<std::size_t>(qr.rank()) < m)
+    throw ModelError(where_of(model, nh.equations.front().constraint),
+                     "the nonholonomic constraints are not independent at the operating point (rank " +
+                         std::to_string(qr.rank()) + " of " + std::to_string(m) + " equations)");
+  if (m >= f)
+    throw ModelError(where_of(model, nh.equations.front().constraint),
+                     "the nonholonomic constraints leave no independent speed: " + std::to_string(m) +
+                         " equations in " + std::to_string(f) + " rates");
+  const std::vector<std::size_t> suggested = pivoted_qr_columns(B);
+  const auto& listed = model.independent_speeds();
+  nh.chosen = listed.empty();
+  if (nh.chosen) return suggested;
+  std::vector<std::size_t> dependent;
+  std::set<std::size_t> speeds;
+  for (const auto& item : listed) {
+    const auto k = static_cast<std::size_t>(model.coordinate_index(item.name));
+    if (!std::binary_search(indep.begin(), indep.end(), k))
+      throw ModelError(item.where, "independent speed '" + item.name +
+                                       "' is the rate of a dependent coordinate of the loops; list independent ones");
+    speeds.insert(position_in(indep, k));
+  }
+  if (speeds.size() != f - m)
+    throw ModelError(listed.front().where, "the nonholonomic constraints leave " + std::to_string(f - m) +
+                                               " independent speeds; " + std::to_string(speeds.size()) + " are listed");
+  for (std::size_t j = 0; j < f; ++j)
+    if (!speeds.count(j)) dependent.push_back(j);
+  MatrixXd Bd(B.rows(), static_cast<Eigen::Index>(m));
+  for (std::size_t d = 0; d < m; ++d) Bd.col(static_cast<Eigen::Index>(d)) = B.col(static_cast<Eigen::Index>(dependent[d]));
+  Eigen::ColPivHouseholderQR<MatrixXd> qd(Bd);
+  qd.setThreshold(1e-10);
+  if (static_cast<std::size_t>(qd.rank()) < m) {
+    std::vector<std::size_t> names_d, names_s;
+    for (std::size_t j : dependent) names_d.push_back(indep[j]);
+    for (std::size_t j = 0; j < f; ++j)
+      if (!std::binary_search(suggested.begin(), suggested.end(), j)) names_s.push_back(indep[j]);
+    throw ModelError(listed.front().where, "the rates of " + coordinate_names(model, names_d) +
+                                               " cannot be found from the listed independent speeds at the operating "
+                                               "point (the constraints are singular in them); independent speeds that "
+                                               "work: " + coordinate_names(model, names_s));
+  }
+  return dependent;
+}
+
+// The operating point's rates satisfy the constraints: the dependent speeds' given rates (0 when
+// not given) equal what the constraints make of the independent ones.
+void check_rates(const Model& model, Equations& eq, const std::vector<std::size_t>& indep, const MatrixXd& B,
+                 const Nonholonomic& nh) {
+  const GiNaC::exmap at = defaults_at_operating_point(model, eq);
+  const auto m = static_cast<Eigen::Index>(nh.dependent_speeds.size());
+  Eigen::VectorXd rates(static_cast<Eigen::Index>(indep.size()));
+  for (std::size_t j = 0; j < indep.size(); ++j)
+    rates(static_cast<Eigen::Index>(j)) = GiNaC::ex_to<GiNaC::numeric>(at.at(eq.yd[indep[j]]).evalf()).to_double();
+  const std::vector<double> a = at_defaults(model, eq, nh.a);
+  Eigen::VectorXd rhs = -Eigen::Map<const Eigen::VectorXd>(a.data(), m);
+  MatrixXd Bd(m, m);
+  for (Eigen::Index d = 0; d < m; ++d) {
+    const std::size_t j = position_in(indep, nh.dependent_speeds[static_cast<std::size_t>(d)]);
+    Bd.col(d) = B.col(static_cast<Eigen::Index>(j));
+    rates(static_cast<Eigen::Index>(j)) = 0;
+  }
+  rhs -= B * rates;
+  const Eigen::VectorXd expected = Bd.colPivHouseholderQr().solve(rhs);
+  const double size = std::max(1.0, rates.cwiseAbs().maxCoeff());
+  for (Eigen::Index d = 0; d < m; ++d) {
+    const std::size_t k = nh.dependent_speeds[static_cast<std::size_t>(d)];
+    const double given = GiNaC::ex_to<GiNaC::numeric>(at.at(eq.yd[k]).evalf()).to_double();
+    if (!(std::abs(given - expected(d)) <= 1e-9 * size))
+      throw ModelError(model.operating_point().where,
+                       "the operating point's rates violate the nonholonomic constraints: the rate of '" +
+                           model.coordinates()[k].name + "' is " + format(given) + " but the constraints make it " +
+                           format(expected(d)) + " with the default parameter values (give it as an expression in "
+                           "the parameters under operating_point: velocity)");
+  }
+}
+
+}  // namespace
+
+Nonholonomic nonholonomic_constraints(const Model& model, Equations& eq) {
+  Nonholonomic nh;
+  if (!model.nonholonomic()) return nh;
+  nh.active = true;
+  Program& prog = eq.program;
+  const std::size_t n = eq.y.size();
+  nh.equations = velocity_equations(model, eq);
+  const std::size_t m = nh.equations.size();
+  GiNaC::exmap rest;
+  for (const auto& s : eq.yd) rest[s] = 0;
+  Program::Substitution at_rest(rest);
+  nh.A = zeros(m, n);
+  for (std::size_t k = 0; k < m; ++k) {
+    for (std::size_t j = 0; j < n; ++j) nh.A[k][j] = prog.diff(nh.equations[k].value, eq.yd[j]);
+    nh.a.push_back(prog.define(prog.substitute(nh.equations[k].value, at_rest)));
+  }
+  const std::vector<std::size_t> indep = independent_coordinates(eq);
+  const ExMatrix B = product(prog, nh.A, tangent_map(eq));
+  const MatrixXd Bn = numbers(model, eq, B);
+  const std::vector<std::size_t> dependent = choose_dependent_speeds(model, indep, Bn, nh);
+  for (std::size_t j = 0; j < indep.size(); ++j)
+    (std::binary_search(dependent.begin(), dependent.end(), j) ? nh.dependent_speeds : nh.speeds).push_back(indep[j]);
+  check_rates(model, eq, indep, Bn, nh);
+  ExMatrix Bd = zeros(m, dependent.size());
+  MatrixXd Bd_num(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(dependent.size()));
+  for (std::size_t k = 0; k < m; ++k)
+    for (std::size_t d = 0; d < dependent.size(); ++d) {
+      Bd[k][d] = B[k][dependent[d]];
+      Bd_num(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(d)) = Bn(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(dependent[d]));
+    }
+  nh.lu = SymbolicLU::factor(prog, Bd, partial_pivoting_rows(Bd_num));
+  return nh;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The linear model of a constrained steady motion (nonholonomic.hpp)
+
+namespace {
+
+// What the linearization works with: the tree's derivatives at the steady motion, with the rates
+// of the dependent speeds and coordinates written in the independent speeds.
+struct SteadyMotion {
+  std::vector<std::size_t> indep, speeds;
+  ExMatrix T, N, P;           // n×f, f×s, f×f
+  ExMatrix M, Hy, Hv, B;      // n×n, n×n, n×n, n×m
+  ExMatrix Cy, Cv;            // r×n
+  ExMatrix G;                 // n×n geometric stiffness of the constraint forces
+  std::vector<ex> r0;         // h at the steady motion
+};
+
+// Rates of the dependent speeds (ẏ_d = Y w + c) and of the loops' dependent coordinates
+// (ẏ = X ẏ_i), as substitutions.
+GiNaC::exmap dependent_rates(Equations& eq, SteadyMotion& sm) {
+  Program& prog = eq.program;
+  const Nonholonomic& nh = eq.nonholonomic;
+  GiNaC::exmap rates;
+  const std::size_t f = sm.indep.size(), s = sm.speeds.size();
+  sm.N = zeros(f, s);
+  for (std::size_t k = 0; k < s; ++k) sm.N[position_in(sm.indep, sm.speeds[k])][k] = 1;
+  if (nh.active) {
+    const ExMatrix B = product(prog, nh.A, sm.T);
+    const std::size_t m = nh.dependent_speeds.size();
+    for (std::size_t k = 0; k < s; ++k) {  // Y = −B_d⁻¹ B_s, column by column
+      std::vector<ex> b(m);
+      for (std::size_t e = 0; e < m; ++e) b[e] = -B[e][position_in(sm.indep, sm.speeds[k])];
+      const std::vector<ex> y = nh.lu.solve(prog, b);
+      for (std::size_t d = 0; d < m; ++d) sm.N[position_in(sm.indep, nh.dependent_speeds[d])][k] = y[d];
+    }
+    std::vector<ex> minus_a(m);
+    for (std::size_t e = 0; e < m; ++e) minus_a[e] = -nh.a[e];
+    const std::vector<ex> c = nh.lu.solve(prog, minus_a);
+    for (std::size_t d = 0; d < m; ++d) {
+      ex v = c[d];
+      const std::size_t row = position_in(sm.indep, nh.dependent_speeds[d]);
+      for (std::size_t k = 0; k < s; ++k)
+        if (!sm.N[row][k].is_zero()) v += sm.N[row][k] * eq.yd[sm.speeds[k]];
+      rates[eq.yd[nh.dependent_speeds[d]]] = prog.define(v);
+    }
+  }
+  if (eq.loops.active) {
+    Program::Substitution on_speeds(rates);
+    for (std::size_t d = 0; d < eq.loops.dependent.size(); ++d) {
+      ex v = 0;
+      for (std::size_t j = 0; j < f; ++j)
+        if (!eq.loops.X[d][j].is_zero()) v += eq.loops.X[d][j] * prog.substitute(eq.yd[sm.indep[j]], on_speeds);
+      rates[eq.yd[eq.loops.dependent[d]]] = prog.define(v);
+    }
+  }
+  for (const auto& u : eq.u) rates[u] = 0;
+  for (const auto& a : eq.ydd) rates[a] = 0;
+  return rates;
+}
+
+// H_y, H_v, B, C_y, C_v and h of the tree at the steady motion.
+void tree_derivatives(Equations& eq, SteadyMotion& sm, Program::Substitution& at_motion) {
+  Program& prog = eq.program;
+  const bool loops = eq.loops.active;
+  const std::vector<ex>& h = loops ? eq.tree.residual : eq.residual;
+  const std::vector<ex>& z = loops ? eq.tree.outputs : eq.outputs;
+  const std::size_t n = eq.y.size(), m = eq.u.size(), r = z.size();
+  auto at = [&](const ex& e) { return prog.define(prog.substitute(e, at_motion)); };
+  sm.M = loops ? eq.tree.M : eq.M;
+  sm.Hy = zeros(n, n), sm.Hv = zeros(n, n), sm.B = zeros(n, m);
+  for (std::size_t i = 0; i < n; ++i) {
+    const ex hi = prog.define(h[i]);
+    sm.r0.push_back(at(hi));
+    for (std::size_t j = 0; j < n; ++j) {
+      sm.Hy[i][j] = at(prog.diff(hi, eq.y[j]));
+      sm.Hv[i][j] = at(prog.diff(hi, eq.yd[j]));
+    }
+    for (std::size_t k = 0; k < m; ++k) sm.B[i][k] = at(-prog.diff(hi, eq.u[k]));
+  }
+  sm.Cy = zeros(r, n), sm.Cv = zeros(r, n);
+  for (std::size_t i = 0; i < r; ++i) {
+    const ex zi = prog.define(z[i]);
+    for (std::size_t j = 0; j < n; ++j) {
+      sm.Cy[i][j] = at(prog.diff(zi, eq.y[j]));
+      sm.Cv[i][j] = at(prog.diff(zi, eq.yd[j]));
+    }
+  }
+}
+
+// The multipliers of h(y0, ẏ0) = Φ_yᵀ λ + Aᵀ μ and the geometric stiffness G of those forces;
+// with nonholonomic constraints also P = [0; −B_d⁻¹ A_q T].
+void constraint_forces(Equations& eq, SteadyMotion& sm, Program::Substitution& at_motion) {
+  Program& prog = eq.program;
+  const Nonholonomic& nh = eq.nonholonomic;
+  const LoopClosure& loops = eq.loops;
+  const std::size_t n = eq.y.size(), f = sm.indep.size();
+  auto at = [&](const ex& e) { return prog.define(prog.substitute(e, at_motion)); };
+  sm.G = zeros(n, n);
+  sm.P = zeros(f, f);
+  std::vector<ex> rest = sm.r0;
+  if (nh.active) {
+    // (Tᵀ h)_d = B_dᵀ μ: the dependent speeds' rows of the projected residual.
+    const ExMatrix Th = product(prog, transposed(sm.T), transposed(ExMatrix{sm.r0}));
+    std::vector<ex> b;
+    for (std::size_t k : nh.dependent_speeds) b.push_back(Th[position_in(sm.indep, k)][0]);
+    const std::vector<ex> mu = nh.lu.solve_transposed(prog, b);
+    const std::size_t m = nh.equations.size();
+    ExMatrix Aq = zeros(m, n);
+    for (std::size_t k = 0; k < m; ++k) {
+      const ex value = prog.define(nh.equations[k].value);
+      for (std::size_t j = 0; j < n; ++j) {
+        Aq[k][j] = at(prog.diff(value, eq.y[j]));
+        if (nh.A[k][j].is_zero()) continue;
+        rest[j] = prog.define(rest[j] - mu[k] * at(nh.A[k][j]));
+        for (std::size_t l = 0; l < n; ++l) {
+          const ex dA = at(prog.diff(nh.A[k][j], eq.y[l]));
+          if (!dA.is_zero()) sm.G[j][l] = prog.define(sm.G[j][l] + mu[k] * dA);
+        }
+      }
+    }
+    const ExMatrix AqT = product(prog, Aq, sm.T);
+    for (std::size_t j = 0; j < f; ++j) {
+      std::vector<ex> column(m);
+      for (std::size_t k = 0; k < m; ++k) column[k] = -AqT[k][j];
+      const std::vector<ex> x = nh.lu.solve(prog, column);
+      for (std::size_t d = 0; d < nh.dependent_speeds.size(); ++d) sm.P[position_in(sm.indep, nh.dependent_speeds[d])][j] = x[d];
+    }
+  }
+  if (loops.active) {
+    std::vector<ex> h_d;
+    for (std::size_t d : loops.dependent) h_d.push_back(rest[d]);
+    const std::vector<ex> lambda = loops.solve_transposed(prog, h_d);
+    for (std::size_t k = 0; k < loops.equations.size(); ++k) {
+      if (lambda[k].is_zero()) continue;
+      for (std::size_t j = 0; j < n; ++j) {
+        if (loops.Phi_y[k][j].is_zero()) continue;
+        for (std::size_t l = 0; l < n; ++l) {
+          const ex H = at(prog.diff(loops.Phi_y[k][j], eq.y[l]));
+          if (!H.is_zero()) sm.G[j][l] = prog.define(sm.G[j][l] + lambda[k] * H);
+        }
+      }
+    }
+  }
+}
+
+// The steady motion is one, with the default parameter values: the projected residual vanishes,
+// the dependent speeds and the loops' dependent rates do not accelerate (P ẏ_i0 = 0, γ = 0), and
+// the linear model does not change along the motion.
+void check_steady_motion(const Model& model, Equations& eq, const SteadyMotion& sm, const ExMatrix& TN,
+                         const std::vector<const ExMatrix*>& matrices) {
+  Program& prog = eq.program;
+  const ExMatrix projected = product(prog, transposed(TN), transposed(ExMatrix{sm.r0}));
+  const MatrixXd res = numbers(model, eq, projected), r0 = numbers(model, eq, ExMatrix{sm.r0});
+  const double size = r0.size() ? r0.cwiseAbs().maxCoeff() : 0.0;
+  if (res.size() && !(res.cwiseAbs().maxCoeff() <= 1e-10 * std::max(size, 1e-300) || res.cwiseAbs().maxCoeff() <= 1e-40))
+    throw ModelError(model.operating_point().where,
+                     "the operating point is not a steady motion: the projected equations of motion leave a "
+                     "residual of " + format(res.cwiseAbs().maxCoeff()) + " (N or N m) with the default parameter values");
+  std::vector<ex> accelerations = eq.loops.active ? eq.loops.gamma : std::vector<ex>{};
+  for (const auto& row : sm.P) {
+    ex a = 0;
+    for (std::size_t j = 0; j < row.size(); ++j)
+      if (!row[j].is_zero()) a += row[j] * eq.yd[sm.indep[j]];
+    accelerations.push_back(prog.define(a));
+  }
+  const std::vector<double> acc = at_defaults(model, eq, accelerations);
+  for (double a : acc)
+    if (!(std::abs(a) <= 1e-10 * std::max(1.0, rate_size(model, eq))))
+      throw ModelError(model.operating_point().where,
+                       "the operating point is not a steady motion: the constraints make the dependent rates change "
+                       "along it (an acceleration of " + format(a) + "); give constant rates that the constraints keep "
+                       "constant (a wheel rolling straight, a constant spin)");
+  // Along the motion the coordinates with nonzero rates change: the linear model must not (else
+  // it is periodic or drifting, such as a spinning wheel that is not axisymmetric). Compared at
+  // the operating point and with those coordinates moved by 0.7 (rad or m), relative to each
+  // matrix's size.
+  const GiNaC::exmap at = defaults_at_operating_point(model, eq);
+  std::vector<ex> entries;
+  for (const ExMatrix* A : matrices)
+    for (const auto& row : *A) entries.insert(entries.end(), row.begin(), row.end());
+  std::vector<double> here;
+  for (std::size_t k = 0; k < eq.y.size(); ++k) {
+    if (GiNaC::ex_to<GiNaC::numeric>(at.at(eq.yd[k]).evalf()).to_double() == 0) continue;
+    if (here.empty()) here = at_defaults(model, eq, entries);
+    const std::vector<double> there = at_defaults(model, eq, entries, {{k, 0.7}});
+    double scale = 0, change = 0;
+    for (std::size_t i = 0; i < here.size(); ++i) {
+      scale = std::max(scale, std::abs(here[i]));
+      change = std::max(change, std::abs(here[i] - there[i]));
+    }
+    if (!(change <= 1e-12 * std::max(scale, 1e-300) || change <= 1e-40))
+      throw ModelError(model.operating_point().where,
+                       "the operating point is not a steady motion: the linearized equations change along it (by " +
+                           format(change) + " of " + format(scale) + " when '" + model.coordinates()[k].name +
+                           "', whose rate is not zero, moves by 0.7); a steady motion needs equations independent of "
+                           "the coordinates that change (an axisymmetric wheel, a level ground)");
+  }
+}
+
+}  // namespace
+
+void linearize_constrained(Equations& eq, LinearEquations& lin) {
+  const Model& model = *eq.model;
+  Program& prog = eq.program;
+  const Nonholonomic& nh = eq.nonholonomic;
+  SteadyMotion sm;
+  sm.indep = independent_coordinates(eq);
+  sm.speeds = nh.active ? nh.speeds : sm.indep;
+  sm.T = tangent_map(eq);
+  Program::Substitution at_motion(dependent_rates(eq, sm));
+  tree_derivatives(eq, sm, at_motion);
+  constraint_forces(eq, sm, at_motion);
+
+  const std::size_t f = sm.indep.size(), s = sm.speeds.size();
+  const ExMatrix TN = product(prog, sm.T, sm.N), TNt = transposed(TN);
+  const ExMatrix MT = product(prog, sm.M, sm.T);
+  // W = M T P + H_v T: what δẏ_i's dependence on δy_i adds through the accelerations and rates.
+  const ExMatrix W = combination(prog, product(prog, MT, sm.P), product(prog, sm.Hv, sm.T), 1);
+  ExMatrix Mr = product(prog, TNt, product(prog, MT, sm.N));
+  for (std::size_t i = 0; i < s; ++i)
+    for (std::size_t j = i + 1; j < s; ++j) Mr[i][j] = Mr[j][i];  // exactly symmetric
+  const ExMatrix Cr = product(prog, TNt, product(prog, W, sm.N));
+  const ExMatrix stiff = combination(prog, product(prog, combination(prog, sm.Hy, sm.G, -1), sm.T), product(prog, W, sm.P), 1);
+  const ExMatrix Kr = product(prog, TNt, stiff);
+  const ExMatrix Br = product(prog, TNt, sm.B);
+  const ExMatrix CyT = combination(prog, product(prog, sm.Cy, sm.T), product(prog, product(prog, sm.Cv, sm.T), sm.P), 1);
+  const ExMatrix CvTN = product(prog, sm.Cv, TN);
+  check_steady_motion(model, eq, sm, TN, {&Mr, &Cr, &Kr, &Br, &sm.P, &sm.N});
+
+  lin.coordinates = sm.indep;
+  lin.speeds = sm.speeds;
+  if (!nh.active) {  // second order in the independent coordinates
+    lin.M = Mr, lin.Q = Cr, lin.K = Kr, lin.B = Br, lin.Cy = CyT, lin.Cv = CvTN;
+    return;
+  }
+  // x = (δy_i, δw):  E = diag(E, M_r),  A = [[P, N], [−K_r, −C_r]],  B = [0; B_r],  C = [C_y T + C_v T P, C_v T N].
+  lin.descriptor = true;
+  const std::size_t nx = f + s, m = eq.u.size(), r = sm.Cy.size();
+  lin.E = zeros(nx, nx), lin.A = zeros(nx, nx), lin.Bx = zeros(nx, m), lin.Cx = zeros(r, nx);
+  for (std::size_t i = 0; i < f; ++i) {
+    lin.E[i][i] = 1;
+    for (std::size_t j = 0; j < f; ++j) lin.A[i][j] = sm.P[i][j];
+    for (std::size_t k = 0; k < s; ++k) lin.A[i][f + k] = sm.N[i][k];
+  }
+  for (std::size_t i = 0; i < s; ++i) {
+    for (std::size_t k = 0; k < s; ++k) {
+      lin.E[f + i][f + k] = Mr[i][k];
+      lin.A[f + i][f + k] = Cr[i][k].is_zero() ? ex(0) : prog.define(-Cr[i][k]);
+    }
+    for (std::size_t j = 0; j < f; ++j) lin.A[f + i][j] = Kr[i][j].is_zero() ? ex(0) : prog.define(-Kr[i][j]);
+    for (std::size_t k = 0; k < m; ++k) lin.Bx[f + i][k] = Br[i][k];
+  }
+  for (std::size_t i = 0; i < r; ++i) {
+    for (std::size_t j = 0; j < f; ++j) lin.Cx[i][j] = CyT[i][j];
+    for (std::size_t k = 0; k < s; ++k) lin.Cx[i][f + k] = CvTN[i][k];
+  }
+}
+
+}  // namespace mbsgen
