@@ -75,6 +75,9 @@ std::vector<std::vector<Eigen::Index>> coupled_blocks(const Eigen::MatrixXd& M) 
 void check_operating_point(const Equations& eq, const LinearEquations& lin) {
   const Model& model = *eq.model;
   if (lin.equilibrium) return;
+  // Nonholonomic constraints: linearize_constrained checked the steady motion (the residual
+  // projected on the independent speeds, the dependent accelerations, the invariance along it).
+  if (lin.descriptor) return;
   // With closed loops the matrices and the residual are those of the independent coordinates
   // (f of the n tree coordinates; loop_closure.hpp).
   const std::size_t n_tree = eq.y.size(), f = eq.M.size();
