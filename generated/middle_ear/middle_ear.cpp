@@ -11,6 +11,10 @@ bool all_finite(const double* x, int n) {
     if (!std::isfinite(x[i])) return false;
   return true;
 }
+// Whether a kernel argument is the operating point's value (to 8 units in the last place).
+inline bool at_operating_point(double argument, double value) {
+  return argument == value || std::fabs(argument - value) <= 8 * 2.220446049250313e-16 * std::fabs(value);
+}
 }  // namespace
 
 extern "C" int middle_ear_abi_version(void) { return 1; }
@@ -4795,7 +4799,7 @@ extern "C" int middle_ear_linear(const double* y0, const double* yd0, const doub
   const double op16 = 0.0;
   const double op17 = 0.0;
   // Exact zeros at the operating point (zero there for every parameter value).
-  if (y0[0] == op0 && y0[1] == op1 && y0[2] == op2 && y0[3] == op3 && y0[4] == op4 && y0[5] == op5 && y0[6] == op6 && y0[7] == op7 && y0[8] == op8 && y0[9] == op9 && y0[10] == op10 && y0[11] == op11 && y0[12] == op12 && y0[13] == op13 && y0[14] == op14 && y0[15] == op15 && y0[16] == op16 && y0[17] == op17) {
+  if (at_operating_point(y0[0], op0) && at_operating_point(y0[1], op1) && at_operating_point(y0[2], op2) && at_operating_point(y0[3], op3) && at_operating_point(y0[4], op4) && at_operating_point(y0[5], op5) && at_operating_point(y0[6], op6) && at_operating_point(y0[7], op7) && at_operating_point(y0[8], op8) && at_operating_point(y0[9], op9) && at_operating_point(y0[10], op10) && at_operating_point(y0[11], op11) && at_operating_point(y0[12], op12) && at_operating_point(y0[13], op13) && at_operating_point(y0[14], op14) && at_operating_point(y0[15], op15) && at_operating_point(y0[16], op16) && at_operating_point(y0[17], op17)) {
     M[22] = 0.0;
     M[41] = 0.0;
     M[73] = 0.0;
@@ -8470,7 +8474,7 @@ extern "C" int middle_ear_linear_structured(const double* y0, const double* yd0,
   const double op16 = 0.0;
   const double op17 = 0.0;
   // Exact zeros at the operating point (zero there for every parameter value).
-  if (y0[0] == op0 && y0[1] == op1 && y0[2] == op2 && y0[3] == op3 && y0[4] == op4 && y0[5] == op5 && y0[6] == op6 && y0[7] == op7 && y0[8] == op8 && y0[9] == op9 && y0[10] == op10 && y0[11] == op11 && y0[12] == op12 && y0[13] == op13 && y0[14] == op14 && y0[15] == op15 && y0[16] == op16 && y0[17] == op17) {
+  if (at_operating_point(y0[0], op0) && at_operating_point(y0[1], op1) && at_operating_point(y0[2], op2) && at_operating_point(y0[3], op3) && at_operating_point(y0[4], op4) && at_operating_point(y0[5], op5) && at_operating_point(y0[6], op6) && at_operating_point(y0[7], op7) && at_operating_point(y0[8], op8) && at_operating_point(y0[9], op9) && at_operating_point(y0[10], op10) && at_operating_point(y0[11], op11) && at_operating_point(y0[12], op12) && at_operating_point(y0[13], op13) && at_operating_point(y0[14], op14) && at_operating_point(y0[15], op15) && at_operating_point(y0[16], op16) && at_operating_point(y0[17], op17)) {
     M[22] = 0.0;
     M[41] = 0.0;
     M[73] = 0.0;

@@ -11,6 +11,10 @@ bool all_finite(const double* x, int n) {
     if (!std::isfinite(x[i])) return false;
   return true;
 }
+// Whether a kernel argument is the operating point's value (to 8 units in the last place).
+inline bool at_operating_point(double argument, double value) {
+  return argument == value || std::fabs(argument - value) <= 8 * 2.220446049250313e-16 * std::fabs(value);
+}
 }  // namespace
 
 extern "C" int sleeping_top_abi_version(void) { return 1; }
@@ -360,7 +364,7 @@ extern "C" int sleeping_top_linear(const double* y0, const double* yd0, const do
   const double op4 = 0.0;
   const double op5 = p[5];
   // Exact zeros at the operating point (zero there for every parameter value).
-  if (y0[0] == op0 && y0[1] == op1 && y0[2] == op2 && yd0[0] == op3 && yd0[1] == op4 && yd0[2] == op5) {
+  if (at_operating_point(y0[0], op0) && at_operating_point(y0[1], op1) && at_operating_point(y0[2], op2) && at_operating_point(yd0[0], op3) && at_operating_point(yd0[1], op4) && at_operating_point(yd0[2], op5)) {
     M[2] = 0.0;
     M[6] = 0.0;
     Q[0] = 0.0;
@@ -614,7 +618,7 @@ extern "C" int sleeping_top_linear_structured(const double* y0, const double* yd
   const double op4 = 0.0;
   const double op5 = p[5];
   // Exact zeros at the operating point (zero there for every parameter value).
-  if (y0[0] == op0 && y0[1] == op1 && y0[2] == op2 && yd0[0] == op3 && yd0[1] == op4 && yd0[2] == op5) {
+  if (at_operating_point(y0[0], op0) && at_operating_point(y0[1], op1) && at_operating_point(y0[2], op2) && at_operating_point(yd0[0], op3) && at_operating_point(yd0[1], op4) && at_operating_point(yd0[2], op5)) {
     M[2] = 0.0;
     M[6] = 0.0;
     D[0] = 0.0;

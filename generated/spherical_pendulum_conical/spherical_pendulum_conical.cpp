@@ -11,6 +11,10 @@ bool all_finite(const double* x, int n) {
     if (!std::isfinite(x[i])) return false;
   return true;
 }
+// Whether a kernel argument is the operating point's value (to 8 units in the last place).
+inline bool at_operating_point(double argument, double value) {
+  return argument == value || std::fabs(argument - value) <= 8 * 2.220446049250313e-16 * std::fabs(value);
+}
 }  // namespace
 
 extern "C" int spherical_pendulum_conical_abi_version(void) { return 1; }
@@ -206,7 +210,7 @@ extern "C" int spherical_pendulum_conical_linear(const double* y0, const double*
   const double op2 = 0.0;
   const double op3 = t129;
   // Exact zeros at the operating point (zero there for every parameter value).
-  if (y0[0] == op0 && y0[1] == op1 && yd0[0] == op2 && yd0[1] == op3) {
+  if (at_operating_point(y0[0], op0) && at_operating_point(y0[1], op1) && at_operating_point(yd0[0], op2) && at_operating_point(yd0[1], op3)) {
     Q[3] = 0.0;
     K[1] = 0.0;
   }
@@ -347,7 +351,7 @@ extern "C" int spherical_pendulum_conical_linear_structured(const double* y0, co
   const double op2 = 0.0;
   const double op3 = t129;
   // Exact zeros at the operating point (zero there for every parameter value).
-  if (y0[0] == op0 && y0[1] == op1 && yd0[0] == op2 && yd0[1] == op3) {
+  if (at_operating_point(y0[0], op0) && at_operating_point(y0[1], op1) && at_operating_point(yd0[0], op2) && at_operating_point(yd0[1], op3)) {
     D[3] = 0.0;
     Ks[1] = 0.0;
     Ks[2] = 0.0;

@@ -271,7 +271,7 @@ std::string zeros_at_operating_point(const Kernel& k) {
   std::ostringstream code;
   code << "  // Exact zeros at the operating point (zero there for every parameter value).\n  if (";
   for (std::size_t i = 0; i < k.at_op.arguments.size(); ++i)
-    code << (i ? " && " : "") << k.at_op.arguments[i] << " == op" << i;
+    code << (i ? " && " : "") << "at_operating_point(" << k.at_op.arguments[i] << ", op" << i << ")";
   code << ") {\n" << zeros.str() << "  }\n";
   return code.str();
 }
@@ -481,17 +481,26 @@ void mark_zeros_at_operating_point(Kernel& k, const std::vector<const ZeroPatter
         if (z[i][j] == EntryZero::at_operating_point) flags[j * rows + i] = 1, any = true;
   }
   if (!any) return;
-  const std::size_t f = lin.y0.size();
-  for (std::size_t i = 0; i < f; ++i) {
+  // The kernel's y0 has every tree coordinate (after `assemble` with closed loops: the dependent
+  // ones, refined by Newton, are not tested; the zeros hold for any of their values); its yd0 the
+  // rates of the independent coordinates.
+  const std::size_t n = lin.y0.size();
+  const std::vector<std::size_t>& dependent = eq.loops.dependent;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::binary_search(dependent.begin(), dependent.end(), i)) continue;
     k.at_op.arguments.push_back("y0[" + std::to_string(i) + "]");
     k.at_op.values.push_back(eq.program.define(lin.y0[i]));
   }
   if (lin.at_rest) return;
-  for (std::size_t i = 0; i < f; ++i)
+  std::size_t j = 0;  // position in yd0
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::binary_search(dependent.begin(), dependent.end(), i)) continue;
     if (std::find(lin.zero_rates.begin(), lin.zero_rates.end(), i) == lin.zero_rates.end()) {
-      k.at_op.arguments.push_back("yd0[" + std::to_string(i) + "]");
+      k.at_op.arguments.push_back("yd0[" + std::to_string(j) + "]");
       k.at_op.values.push_back(eq.program.define(lin.yd0[i]));
     }
+    ++j;
+  }
 }
 
 // The manifest's "constraints": the tree's coordinates, which are independent (and whether
@@ -533,7 +542,11 @@ std::string sparsity_json(const LinearEquations& lin) {
   const std::pair<const char*, const ZeroPattern*> matrices[] = {
       {"M", &z.M}, {"Q", &z.Q},   {"K", &z.K}, {"B", &z.B}, {"C_y", &z.Cy}, {"C_v", &z.Cv},
       {"D", &z.D}, {"G", &z.G}, {"K_s", &z.Ks}, {"N", &z.N}};
-  for (const auto& [name, pattern] : matrices) {
+  const std::pair<const char*, const ZeroPattern*> descriptor[] = {{"E", &z.E}, {"A", &z.A}, {"B_x", &z.Bx}, {"C_x", &z.Cx}};
+  for (const auto& [name, pattern] : lin.descriptor ? std::vector<std::pair<const char*, const ZeroPattern*>>(
+                                                          std::begin(descriptor), std::end(descriptor))
+                                                    : std::vector<std::pair<const char*, const ZeroPattern*>>(
+                                                          std::begin(matrices), std::end(matrices))) {
     j << ",\n    \"" << name << "\": [";
     const std::vector<std::string> rows = pattern_rows(*pattern);
     for (std::size_t i = 0; i < rows.size(); ++i) j << (i ? ", " : "") << "\"" << rows[i] << "\"";
@@ -545,12 +558,32 @@ std::string sparsity_json(const LinearEquations& lin) {
 
 }  // namespace
 
+// The manifest's "nonholonomic": the velocity constraints, the independent speeds (and whether
+// mbsgen chose them) and the descriptor state x = (coordinates, speeds).
+std::string nonholonomic_json(const Model& model, const Equations& eq, const LinearEquations& lin) {
+  const Nonholonomic& nh = eq.nonholonomic;
+  auto names = [&](const std::vector<std::size_t>& v, const char* suffix) {
+    std::string s;
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + json_string(model.coordinates()[v[i]].name + suffix);
+    return s;
+  };
+  std::ostringstream j;
+  j << "{\"equations\": [";
+  for (std::size_t k = 0; k < nh.equations.size(); ++k)
+    j << (k ? ", " : "") << "{\"constraint\": " << json_string(nh.equations[k].constraint)
+      << ", \"component\": " << json_string(nh.equations[k].component) << "}";
+  j << "], \"independent_speeds\": [" << names(lin.speeds, "_dot") << "], \"dependent_speeds\": ["
+    << names(nh.dependent_speeds, "_dot") << "], \"chosen\": " << (nh.chosen ? "true" : "false")
+    << ",\n    \"state\": [" << names(lin.coordinates, "") << ", " << names(lin.speeds, "_dot") << "]}";
+  return j.str();
+}
+
 // The header: the preamble (banner, operation counts), the scene's macros, sizes, names and the
 // kernels' declarations.
 std::string header_text(const Model& model, const Equations& eq, const LinearEquations& lin, const SceneSelection& scene,
                         const GeneratedCode& out, const std::string& preamble) {
   const bool loops = eq.loops.active;
-  const std::size_t f = lin.M.size(), n = eq.y.size(), m = eq.u.size(), r = eq.outputs.size();
+  const std::size_t f = lin.coordinates.size(), n = eq.y.size(), m = eq.u.size(), r = eq.outputs.size();
   const std::size_t nb = model.bodies().size(), np = eq.p.size();
   std::ostringstream h;
   h << preamble << "#pragma once\n\n";
@@ -583,6 +616,11 @@ std::string header_text(const Model& model, const Equations& eq, const LinearEqu
          "assemble\n// and the constraint kernels all " << n << " tree coordinates.\nenum { " << out.id
       << "_n_tree_coordinates = " << n << ", " << out.id << "_n_constraints = " << eq.loops.equations.size()
       << " };\nextern const char* const " << out.id << "_tree_coordinate_names[];\n";
+  if (lin.descriptor)
+    h << "// Nonholonomic constraints: the linear model is E x' = A x + B u, z = C x with x the " << f
+      << " coordinates and\n// the " << lin.speeds.size() << " independent speeds (the rates of speed_names).\nenum { "
+      << out.id << "_n_speeds = " << lin.speeds.size() << " };\nextern const char* const " << out.id
+      << "_speed_names[];\n";
   h << "\n";
   for (const auto& k : out.kernels) h << k.signature << ";\n";
   h << "\n#ifdef __cplusplus\n}\n#endif\n";
@@ -594,7 +632,7 @@ std::string header_text(const Model& model, const Equations& eq, const LinearEqu
 std::string manifest_json(const Model& model, const Equations& eq, const LinearEquations& lin, const SceneSelection& scene,
                           const GeneratedCode& out) {
   const bool loops = eq.loops.active;
-  const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
+  const std::size_t f = lin.coordinates.size(), m = eq.u.size(), r = eq.outputs.size();
   const std::size_t nb = model.bodies().size(), np = eq.p.size();
   std::ostringstream j;
   j << "{\n  \"generator\": \"mbsgen " << kGeneratorVersion << "\",\n  \"abi_version\": " << kAbiVersion
@@ -617,6 +655,7 @@ std::string manifest_json(const Model& model, const Equations& eq, const LinearE
   }
   j << "]";
   if (loops) j << ",\n  \"constraints\": " << constraints_json(model, eq.loops);
+  if (lin.descriptor) j << ",\n  \"nonholonomic\": " << nonholonomic_json(model, eq, lin);
   j << ",\n  \"parameters\": [";
   for (std::size_t i = 0; i < np; ++i) {
     const auto& q = model.parameters()[i];
@@ -659,22 +698,11 @@ std::string manifest_json(const Model& model, const Equations& eq, const LinearE
   return j.str();
 }
 
-// The kernels of docs/generator.md, in emission order. With closed loops the coordinates y are
-// the tree's (n), the rates yd the independent ones, and the matrices those of the independent
-// coordinates (f); such kernels are wrapped (Kernel::wrapped).
-std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const LinearEquations& lin) {
-  const bool loops = eq.loops.active;
+// mass_matrix, residual, linear and linear_structured: the second-order model's kernels.
+void second_order_kernels(Equations& eq, const LinearEquations& lin, const std::vector<ex>& y, const std::vector<ex>& yd,
+                          const std::vector<ex>& p, std::vector<Kernel>& kernels) {
   const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
-  const std::size_t nb = model.bodies().size();
-  std::vector<ex> y(eq.y.begin(), eq.y.end()), yd, u(eq.u.begin(), eq.u.end()), p(eq.p.begin(), eq.p.end());
-  std::vector<ex> y0_out, yd0_out;
-  for (std::size_t k = 0; k < eq.yd.size(); ++k)
-    if (!loops || std::binary_search(eq.loops.independent.begin(), eq.loops.independent.end(), k)) {
-      yd.push_back(eq.yd[k]);
-      y0_out.push_back(lin.y0[k]);
-      yd0_out.push_back(lin.yd0[k]);
-    }
-  std::vector<Kernel> kernels;
+  const std::vector<ex> u(eq.u.begin(), eq.u.end());
   kernels.push_back({"mass_matrix", "M(y, p): f×f mass matrix, column-major",
                      {{"y", y}, {"p", p}},
                      {{"M", column_major(eq.M, f, f), ""}}});
@@ -704,6 +732,46 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
                                 &lin.zeros.B, &lin.zeros.Cy, &lin.zeros.Cv}, eq, lin);
   mark_zeros_at_operating_point(kernels.back(), {&lin.zeros.M, &lin.zeros.D, &lin.zeros.G,
                                 &lin.zeros.Ks, &lin.zeros.N}, eq, lin);
+}
+
+// descriptor: E, A (n×n), B (n×m), C (r×n) of E x' = A x + B u, z = C x (nonholonomic.hpp).
+Kernel descriptor_kernel(Equations& eq, const LinearEquations& lin, const std::vector<ex>& y, const std::vector<ex>& yd,
+                         const std::vector<ex>& p) {
+  const std::size_t nx = lin.E.size(), m = eq.u.size(), r = eq.outputs.size();
+  std::vector<ex> none;
+  Kernel k{"descriptor",
+           "descriptor model E x' = A x + B u, z = C x at (y0, yd0) with x = (coordinates, independent speeds): "
+           "E, A (n×n), B (n×m), C (r×n), column-major; yd0 entries of dependent speeds are not used",
+           {{"y0", y}, {"yd0", lin.at_rest ? none : yd}, {"p", p}},
+           {{"E", column_major(lin.E, nx, nx), ""},
+            {"A", column_major(lin.A, nx, nx), ""},
+            {"B", column_major(lin.Bx, nx, m), ""},
+            {"C", column_major(lin.Cx, r, nx), ""}}};
+  mark_zeros_at_operating_point(k, {&lin.zeros.E, &lin.zeros.A, &lin.zeros.Bx, &lin.zeros.Cx}, eq, lin);
+  return k;
+}
+
+// The kernels of docs/generator.md, in emission order. With closed loops the coordinates y are
+// the tree's (n), the rates yd the independent ones, and the matrices those of the independent
+// coordinates (f); such kernels are wrapped (Kernel::wrapped).
+std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const LinearEquations& lin) {
+  const bool loops = eq.loops.active;
+  const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
+  const std::size_t nb = model.bodies().size();
+  std::vector<ex> y(eq.y.begin(), eq.y.end()), yd, u(eq.u.begin(), eq.u.end()), p(eq.p.begin(), eq.p.end());
+  std::vector<ex> y0_out, yd0_out;
+  for (std::size_t k = 0; k < eq.yd.size(); ++k)
+    if (!loops || std::binary_search(eq.loops.independent.begin(), eq.loops.independent.end(), k)) {
+      yd.push_back(eq.yd[k]);
+      y0_out.push_back(lin.y0[k]);
+      yd0_out.push_back(lin.yd0[k]);
+    }
+  std::vector<Kernel> kernels;
+  if (lin.descriptor) {
+    kernels.push_back(descriptor_kernel(eq, lin, y, yd, p));
+  } else {
+    second_order_kernels(eq, lin, y, yd, p, kernels);
+  }
   kernels.push_back({"operating_point",
                      "operating point y0 (or the initial guess of an equilibrium) and steady rates yd0",
                      {{"p", p}},
@@ -791,7 +859,9 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
     out.kernels.push_back({"assemble", "int " + out.id + "_assemble(const double* yi, const double* p, double* y)", 0});
   }
   for (const auto& k : kernels) {
-    const std::string as = k.name == "outputs_general" ? "outputs" : k.name == "output_terms" ? "linear" : k.name;
+    const std::string as = k.name == "outputs_general"                          ? "outputs"
+                           : k.name == "output_terms" || k.name == "descriptor" ? "linear"
+                                                                                : k.name;
     if (!scene.emits(as)) continue;
     EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse);
     kernel_code << ek.code;
@@ -836,11 +906,23 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   std::ostringstream c;
   c << banner << ops.str() << "#include \"" << out.id << ".hpp\"\n\n#include <cmath>\n\n";
   c << "namespace {\nbool all_finite(const double* x, int n) {\n  for (int i = 0; i < n; ++i)\n"
-       "    if (!std::isfinite(x[i])) return false;\n  return true;\n}\n}  // namespace\n\n";
+       "    if (!std::isfinite(x[i])) return false;\n  return true;\n}\n";
+  // An argument equals the operating point's value when it is within 8 units in the last place:
+  // the operating_point kernel and this one compute the value by different roundings (a speed
+  // v/r as v*(1/r)), and the entries zero at the operating point are of that rounding size there.
+  c << "// Whether a kernel argument is the operating point's value (to 8 units in the last place).\n"
+       "inline bool at_operating_point(double argument, double value) {\n"
+       "  return argument == value || std::fabs(argument - value) <= 8 * 2.220446049250313e-16 * std::fabs(value);\n}\n";
+  c << "}  // namespace\n\n";
   c << "extern \"C\" int " << out.id << "_abi_version(void) { return " << kAbiVersion << "; }\n";
   c << names_array("coordinate_names", cn) << names_array("parameter_names", pn)
     << names_array("input_names", in) << names_array("output_names", on);
   if (loops) c << names_array("tree_coordinate_names", tree);
+  if (lin.descriptor) {
+    std::vector<std::string> sn;
+    for (std::size_t k : lin.speeds) sn.push_back(model.coordinates()[k].name);
+    c << names_array("speed_names", sn);
+  }
   c << "extern \"C\" const double " << out.id << "_parameter_defaults[] = {";
   for (const auto& q : model.parameters()) c << format_double(q.value) << ", ";
   c << "0.0};\n\n";

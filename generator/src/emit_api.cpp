@@ -149,6 +149,9 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     << (linear_spacing ? "true" : "false") << ", " << literal(kGeneratorVersion);
   // Trailing optional kernels: C_a and D of reaction outputs, and the nonlinear outputs.
   c << ", " << kernel("output_terms") << ", " << kernel("outputs");
+  // Nonholonomic models: the independent speeds and the descriptor kernel.
+  if (lin.descriptor)
+    c << ",\n      " << lin.speeds.size() << ", " << id << "_speed_names, " << kernel("descriptor");
   c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"

@@ -6,6 +6,7 @@
 #include "mbsgen/generator/linearize.hpp"
 #include "mbsgen/generator/program.hpp"
 
+#include <algorithm>
 #include <cstdint>
 
 #include <stdexcept>
@@ -116,7 +117,10 @@ inline GiNaC::exmap sample_point(const Equations& eq, const LinearEquations& lin
     GiNaC::exmap p;
     for (const auto& x : eq.p) p[x] = values[x];
     for (std::size_t k = 0; k < eq.y.size(); ++k) {
-      if (!lin.equilibrium && !eq.loops.active) values[eq.y[k]] = GiNaC::evalf(lin.y0[k].subs(p, GiNaC::subs_options::no_pattern));
+      // The loops' dependent coordinates stay free: the kernels close them by Newton's method, so
+      // a zero at the operating point must hold for any of their values.
+      const bool dependent = std::binary_search(eq.loops.dependent.begin(), eq.loops.dependent.end(), k);
+      if (!lin.equilibrium && !dependent) values[eq.y[k]] = GiNaC::evalf(lin.y0[k].subs(p, GiNaC::subs_options::no_pattern));
       values[eq.yd[k]] = GiNaC::evalf(lin.yd0[k].subs(p, GiNaC::subs_options::no_pattern));
     }
   }

@@ -165,16 +165,17 @@ StructuralZeros find_structural_zeros(Equations& eq, LinearEquations& lin) {
       (*t.pattern)[i].assign((*t.matrix)[i].size(), EntryZero::nonzero);
   }
   const std::vector<ZeroPattern> everywhere = screen(eq, lin, z, false);
-  // A model with closed loops has its dependent coordinates refined by the kernels (Newton),
-  // not equal to the given expressions bit for bit: no zeros at the operating point only.
-  const bool given = !lin.equilibrium && !eq.loops.active;
+  // A model with closed loops has its dependent coordinates refined by the kernels (Newton), not
+  // equal to the given expressions bit for bit: they stay free in the proof, so that a zero at the
+  // operating point holds for whatever values they take.
+  const bool given = !lin.equilibrium;
   const std::vector<ZeroPattern> at_op =
       given ? screen(eq, lin, z, true) : std::vector<ZeroPattern>(ts.size());
 
   // The operating point, substituted through the program once for all candidates.
   GiNaC::exmap op_values;
   for (std::size_t k = 0; k < eq.y.size(); ++k) {
-    op_values[eq.y[k]] = lin.y0[k];
+    if (!std::binary_search(eq.loops.dependent.begin(), eq.loops.dependent.end(), k)) op_values[eq.y[k]] = lin.y0[k];
     op_values[eq.yd[k]] = lin.yd0[k];
   }
   Program::Substitution op(op_values);

@@ -227,13 +227,17 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   const Toolchain tc = toolchain();
   std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
   for (const auto& a : tc.includes) key += '\0' + a;
-  // A library rebuilt in place (a developer's build tree) makes a new key: its size and time of
-  // modification are part of it, so a solver is never linked against an older runtime.
-  for (const auto& a : tc.libraries) {
+  // A library or generator rebuilt in place (a developer's build tree) makes a new key: their size
+  // and time of modification are part of it, so a solver is never linked against an older runtime
+  // nor built from kernels an older generator wrote.
+  std::vector<std::string> artifacts = tc.libraries;
+  artifacts.push_back("/proc/self/exe");
+  for (const auto& a : artifacts) {
     key += '\0' + a;
     std::error_code ec;
-    const auto size = fs::file_size(a, ec);
-    const auto time = fs::last_write_time(a, ec);
+    const fs::path file = a == "/proc/self/exe" ? fs::read_symlink(a, ec) : fs::path(a);
+    const auto size = fs::file_size(file, ec);
+    const auto time = fs::last_write_time(file, ec);
     if (!ec) key += '\0' + std::to_string(size) + '\0' + std::to_string(time.time_since_epoch().count());
   }
   char hash[17];

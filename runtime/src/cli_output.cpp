@@ -85,7 +85,14 @@ std::string json_string(const std::string& s) {
 
 void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::Index size,
                  const ModesFormat& f) {
-  const auto& modes = solver.modes();
+  std::ostringstream method;
+  method << "# method " << solver.method() << ", rank M " << solver.rank_M() << "/" << size << ", rank K "
+         << solver.rank_K() << "/" << size << "\n";
+  write_modes(out, solver.modes(), solver.stability(), size, f, method.str());
+}
+
+void write_modes(std::ostream& out, const std::vector<Mode>& modes, Stability stability, Eigen::Index size,
+                 const ModesFormat& f, const std::string& method_line) {
   auto coordinate = [&f](Eigen::Index i) {
     return static_cast<std::size_t>(i) < f.coordinate_names.size()
                ? f.coordinate_names[static_cast<std::size_t>(i)]
@@ -112,7 +119,7 @@ void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::I
       }
       out << "}";
     }
-    out << "\n],\"stability\":\"" << to_string(solver.stability()) << "\"}\n";
+    out << "\n],\"stability\":\"" << to_string(stability) << "\"}\n";
   } else if (f.format == "csv") {
     out << "lambda_re,lambda_im,natural_frequency_hz,damped_frequency_hz,damping_ratio,"
            "backward_error,error_bound,kind";
@@ -140,10 +147,8 @@ void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::I
           << pad(short_num(m.damped_frequency_hz), 15) << pad(short_num(m.damping_ratio), 15)
           << pad(short_num(m.backward_error), 15) << pad(short_num(m.error_bound), 15) << "  "
           << kind_label(m) << "\n";
-    out << "# method " << solver.method() << ", rank M " << solver.rank_M() << "/" << size
-        << ", rank K " << solver.rank_K() << "/" << size << "\n";
-    out << "# stability " << to_string(solver.stability()) << ": "
-        << stability_reason(solver.stability()) << "\n";
+    out << method_line;
+    out << "# stability " << to_string(stability) << ": " << stability_reason(stability) << "\n";
     if (f.shapes) {
       out << "# mode shapes (unit 2-norm, largest entry real positive): amplitude, phase [deg]\n";
       out << pad("coordinate", 16);

@@ -59,6 +59,10 @@ struct ModesFormat {
 /// Writes the modes; the table ends with a line "# method …, rank M …, rank K …".
 void write_modes(std::ostream& out, const QuadraticEigenSolver& solver, Eigen::Index size,
                  const ModesFormat& f);
+/// The same for any list of modes (the first-order solver of nonholonomic models); the table's
+/// footer starts with `method_line` (ending in a newline).
+void write_modes(std::ostream& out, const std::vector<Mode>& modes, Stability stability, Eigen::Index size,
+                 const ModesFormat& f, const std::string& method_line);
 
 struct FrfTable {
   std::string format = "table";

@@ -52,7 +52,7 @@ GeneratedModel::GeneratedModel(const ModelKernels& kernels) : k_(kernels) {
     throw Error("GeneratedModel: model '" + std::string(k_.id) + "' has kernel ABI version " +
                 std::to_string(k_.abi_version) + ", this runtime expects " +
                 std::to_string(kKernelAbiVersion) + "; regenerate it");
-  if (!k_.operating_point || !k_.linear)
+  if (!k_.operating_point || (!k_.linear && !k_.descriptor))
     throw Error("GeneratedModel: model '" + std::string(k_.id) +
                 "' lacks the operating_point or linear kernel (its scene asks for no linear analysis)");
   parameter_names_ = name_list(k_.parameter_names, k_.n_parameters);
@@ -159,7 +159,30 @@ Eigen::VectorXd GeneratedModel::outputs(const OperatingPoint& op) const {
   return z;
 }
 
+DescriptorModel GeneratedModel::descriptor_model(const OperatingPoint& op) const {
+  if (!k_.descriptor)
+    throw Error("GeneratedModel::descriptor_model: model '" + std::string(k_.model) +
+                "' has no nonholonomic constraints; its linear model is second order (linear_model)");
+  const Eigen::Index f = size(), s = k_.n_speeds, n = f + s, m = k_.n_inputs, r = k_.n_outputs;
+  if (op.y0.size() != f || op.yd0.size() != f)
+    throw DimensionError("GeneratedModel::descriptor_model: operating point of size " + std::to_string(op.y0.size()) +
+                         "/" + std::to_string(op.yd0.size()) + " for a model with " + std::to_string(f) + " coordinates");
+  Eigen::MatrixXd E(n, n), A(n, n), B(n, m), C(r, n);
+  double dummy[1];
+  auto data = [&](Eigen::MatrixXd& X) { return X.size() ? X.data() : dummy; };
+  check_status(k_.descriptor(op.y0.data(), op.yd0.data(), p_.data(), E.data(), A.data(), data(B), data(C)),
+               "descriptor", k_.model);
+  std::vector<std::string> states = name_list(k_.coordinate_names, k_.n_coordinates);
+  for (const auto& speed : name_list(k_.speed_names, k_.n_speeds)) states.push_back(speed + "_dot");
+  return DescriptorModel(E, A, B, C, {}, states, name_list(k_.input_names, k_.n_inputs),
+                         name_list(k_.output_names, k_.n_outputs), name_list(k_.input_units, k_.n_inputs),
+                         name_list(k_.output_units, k_.n_outputs));
+}
+
 LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
+  if (!k_.linear)
+    throw Error("model '" + std::string(k_.model) + "' has nonholonomic constraints: its linear model is first order, "
+                "E x' = A x + B u (GeneratedModel::descriptor_model)");
   const Eigen::Index f = size(), m = k_.n_inputs, r = k_.n_outputs;
   if (op.y0.size() != f || op.yd0.size() != f)
     throw DimensionError("GeneratedModel::linear_model: operating point of size " +

@@ -10,17 +10,27 @@ namespace mbsgen {
 namespace {
 
 // The spectrum of the model at its current parameters.
+// (The first-order solver for a model with nonholonomic constraints.)
 SweepPoint spectrum(const GeneratedModel& model, double value) {
-  const LinearModel lin = model.linear_model();
-  QuadraticEigenOptions opt;
-  opt.one_per_conjugate_pair = false;
-  QuadraticEigenSolver solver(lin.size(), opt);
-  solver.compute(lin);
+  std::vector<Mode> modes;
+  Stability stability = Stability::undecided;
+  if (model.is_descriptor()) {
+    DescriptorEigenSolver solver;
+    solver.compute(model.descriptor_model());
+    modes = solver.modes(), stability = solver.stability();
+  } else {
+    const LinearModel lin = model.linear_model();
+    QuadraticEigenOptions opt;
+    opt.one_per_conjugate_pair = false;
+    QuadraticEigenSolver solver(lin.size(), opt);
+    solver.compute(lin);
+    modes = solver.modes(), stability = solver.stability();
+  }
   SweepPoint p;
   p.value = value;
-  p.stability = solver.stability();
+  p.stability = stability;
   p.abscissa = p.raw_abscissa = -std::numeric_limits<double>::infinity();
-  for (const Mode& m : solver.modes()) {
+  for (const Mode& m : modes) {
     if (m.kind != EigenvalueKind::finite && m.kind != EigenvalueKind::zero) continue;
     p.eigenvalues.push_back(m.lambda);
     // A real part within the eigenvalue's error bound counts as 0: the data do not tell its sign
@@ -51,9 +61,24 @@ std::complex<double> rightmost(const SweepPoint& p) {
   return best;
 }
 
-// Bisection between a and b, whose decided signs differ, on the sign of the largest real part
-// itself (within the error band the computed sign is still the nearer one: the crossing is found
-// to about error_bound / |d Re λ/dp| instead of that band's width).
+// Whether the computed spectrum grows, by the signs of the real parts themselves (no error
+// bounds): an eigenvalue counts when |λ| exceeds 100·u of the largest (below that it is the
+// rounding of a zero, such as a rolling disk's neighbouring steady turn, whose normwise error
+// bound is no guide), and grows when Re λ exceeds 100·u·|λ| (the rounding of a pair on the
+// imaginary axis, which a gyroscopic system keeps there).
+bool grows(const SweepPoint& p) {
+  const double u = std::numeric_limits<double>::epsilon();
+  double scale = 0;
+  for (const auto& l : p.eigenvalues) scale = std::max(scale, std::abs(l));
+  for (const auto& l : p.eigenvalues)
+    if (std::abs(l) > 100 * u * scale && l.real() > 100 * u * std::abs(l)) return true;
+  return false;
+}
+
+// Bisection between a and b, whose decided signs differ, on grows(): within the error band the
+// computed sign is still the nearer one, so the crossing is found to about the eigenvalue's actual
+// error / |d Re λ/dp| instead of its bound's (a bicycle's capsize root near the crossing has a
+// normwise bound of 1e10, coupled to the heading's Jordan chain, and an error of 1e-13).
 StabilityBoundary refine(GeneratedModel& model, const std::string& parameter, SweepPoint a, SweepPoint b,
                          const SweepOptions& options) {
   const bool a_unstable = a.abscissa > 0;
@@ -61,10 +86,11 @@ StabilityBoundary refine(GeneratedModel& model, const std::string& parameter, Sw
     const double width = std::abs(b.value - a.value);
     if (width <= options.relative_tolerance * std::max(1.0, std::abs(a.value))) break;
     const SweepPoint mid = at(model, parameter, (a.value + b.value) / 2);
-    if ((mid.raw_abscissa > 0) == a_unstable)
+    if (grows(mid) == a_unstable) {
       a = mid;
-    else
+    } else {
       b = mid;
+    }
   }
   StabilityBoundary s;
   s.value = (a.value + b.value) / 2;

@@ -70,8 +70,27 @@ int run_info(const ModelKernels& k, const Options& o, std::ostream& out) {
   return 0;
 }
 
+// A nonholonomic model's modes: the first-order pencil λE − A (descriptor_model.hpp).
+int run_descriptor_modes(const GeneratedModel& model, const Options& o, std::ostream& out) {
+  const DescriptorModel d = model.descriptor_model();
+  DescriptorEigenOptions opt;
+  opt.one_per_conjugate_pair = !o.all;
+  DescriptorEigenSolver solver(opt);
+  solver.compute(d);
+  ModesFormat f;
+  f.format = o.format;
+  f.shapes = o.shapes;
+  f.coordinate_names = d.state_names();
+  std::ostringstream method;
+  method << "# method descriptor (first order, " << d.size() << " states), exact zeros " << solver.num_zero()
+         << ", infinite " << solver.num_infinite() << "\n";
+  write_modes(out, solver.modes(), solver.stability(), d.size(), f, method.str());
+  return 0;
+}
+
 int run_modes(const ModelKernels& k, const Options& o, std::ostream& out) {
   GeneratedModel model = configured(k, o);
+  if (model.is_descriptor()) return run_descriptor_modes(model, o, out);
   const LinearModel lin = model.linear_model();
   QuadraticEigenOptions opt;
   opt.one_per_conjugate_pair = !o.all;
@@ -85,12 +104,12 @@ int run_modes(const ModelKernels& k, const Options& o, std::ostream& out) {
   return 0;
 }
 
-int run_frf(const ModelKernels& k, const Options& o, std::ostream& out, std::ostream& err) {
-  GeneratedModel model = configured(k, o);
-  const Eigen::Index input = model.input_index(o.input), output = model.output_index(o.output);
-  if (!o.plot.empty()) refuse_special_file(o.plot, "--plot");  // before the sweep, not after
+// The second-order model's response (FrequencyResponse with the chosen method), in chunks with
+// progress on a terminal.
+void frf_second_order(const GeneratedModel& model, const Options& o, Eigen::Index input, Eigen::Index output,
+                      FrfResult& r, std::ostream& err) {
   const LinearModel lin = model.linear_model();
-  const Eigen::VectorXd hz = sweep_hz(o.from, o.to, o.points, o.spacing == "log");
+  const Eigen::VectorXd& hz = r.hz;
   FrfOptions opt;
   opt.method = parse_frf_method(o.method);
   opt.on_pole = o.on_pole == "error" ? PoleHandling::raise : PoleHandling::flag;
@@ -98,7 +117,6 @@ int run_frf(const ModelKernels& k, const Options& o, std::ostream& out, std::ost
   // Progress on a terminal for long sweeps; quiet when stderr is a file or a pipe. The sweep
   // runs in chunks (the factorizations a method needs are made once, on the first chunk).
   const bool progress = o.points >= 2000 && ::isatty(STDERR_FILENO);
-  FrfResult r{hz, Eigen::VectorXcd(o.points), Eigen::VectorXd(o.points), {}, FrfMethod::automatic};
   const long chunk = progress ? (o.points + 49) / 50 : o.points;
   for (long first = 0; first < o.points; first += chunk) {
     const long n = std::min(chunk, o.points - first);
@@ -111,6 +129,24 @@ int run_frf(const ModelKernels& k, const Options& o, std::ostream& out, std::ost
   if (progress) err << "\r          \r";
   r.method = frf.method();
   for (const auto& w : frf.warnings()) err << "warning: " << w << "\n";
+}
+
+int run_frf(const ModelKernels& k, const Options& o, std::ostream& out, std::ostream& err) {
+  GeneratedModel model = configured(k, o);
+  const Eigen::Index input = model.input_index(o.input), output = model.output_index(o.output);
+  if (!o.plot.empty()) refuse_special_file(o.plot, "--plot");  // before the sweep, not after
+  const Eigen::VectorXd hz = sweep_hz(o.from, o.to, o.points, o.spacing == "log");
+  FrfResult r{hz, Eigen::VectorXcd(o.points), Eigen::VectorXd(o.points), {}, FrfMethod::automatic};
+  if (model.is_descriptor()) {  // (iΩE − A)⁻¹ B by complex LU per frequency
+    const DescriptorFrf d = descriptor_frequency_response(model.descriptor_model(), hz * kTwoPi, input, {output},
+                                                          o.on_pole == "error" ? PoleHandling::raise : PoleHandling::flag);
+    r.g = d.response.row(0).transpose();
+    r.rcond = d.rcond;
+    r.flags = d.flags;
+    r.method = FrfMethod::direct;
+  } else {
+    frf_second_order(model, o, input, output, r, err);
+  }
   FrfTable t;
   t.format = o.format;
   t.input_json = json_string(o.input);
@@ -131,6 +167,9 @@ int run_frf(const ModelKernels& k, const Options& o, std::ostream& out, std::ost
 
 int run_static(const ModelKernels& k, const Options& o, std::ostream& out) {
   GeneratedModel model = configured(k, o);
+  if (model.is_descriptor())
+    throw Error("static: model '" + std::string(k.model) + "' has nonholonomic constraints and is linearized about "
+                "its given steady motion; there is no static equilibrium to find (modes, frf, sweep and matrices apply)");
   const OperatingPoint op = model.operating_point();
   const auto names = name_list(k.coordinate_names, k.n_coordinates);
   if (o.format == "json") {
@@ -240,12 +279,22 @@ void json_names(std::ostream& out, const std::vector<std::string>& v) {
 
 int run_matrices(const ModelKernels& k, const Options& o, std::ostream& out, std::ostream& err) {
   GeneratedModel model = configured(k, o);
-  const LinearModel lin = model.linear_model();
-  std::vector<std::pair<const char*, const Eigen::MatrixXd*>> mats = {
-      {"M", &lin.M()}, {"Q", &lin.Q()}, {"K", &lin.K()}, {"B", &lin.B()}, {"C_y", &lin.C_y()}, {"C_v", &lin.C_v()}};
-  // Outputs on ÿ and u (joint loads; the kernels' optional output_terms): only when nonzero.
-  if (lin.has_output_accelerations()) mats.push_back({"C_a", &lin.C_a()});
-  if (lin.has_feedthrough()) mats.push_back({"D", &lin.D()});
+  // A nonholonomic model's E, A, B, C (state: coordinates and independent speeds).
+  const bool first_order = model.is_descriptor();
+  const LinearModel lin = first_order ? LinearModel(Eigen::MatrixXd::Identity(1, 1), Eigen::MatrixXd(), Eigen::MatrixXd::Zero(1, 1))
+                                      : model.linear_model();
+  const DescriptorModel d = first_order ? model.descriptor_model()
+                                        : DescriptorModel(Eigen::MatrixXd::Identity(1, 1), Eigen::MatrixXd::Zero(1, 1),
+                                                          Eigen::MatrixXd::Zero(1, 0), Eigen::MatrixXd::Zero(0, 1));
+  std::vector<std::pair<const char*, const Eigen::MatrixXd*>> mats;
+  if (first_order) {
+    mats = {{"E", &d.E()}, {"A", &d.A()}, {"B", &d.B()}, {"C", &d.C()}};
+  } else {
+    mats = {{"M", &lin.M()}, {"Q", &lin.Q()}, {"K", &lin.K()}, {"B", &lin.B()}, {"C_y", &lin.C_y()}, {"C_v", &lin.C_v()}};
+    // Outputs on ÿ and u (joint loads; the kernels' optional output_terms): only when nonzero.
+    if (lin.has_output_accelerations()) mats.push_back({"C_a", &lin.C_a()});
+    if (lin.has_feedthrough()) mats.push_back({"D", &lin.D()});
+  }
   if (o.format == "mtx") {
     namespace fs = std::filesystem;
     const fs::path dir = o.out_dir.empty() ? fs::path(".") : fs::path(o.out_dir);
@@ -263,12 +312,12 @@ int run_matrices(const ModelKernels& k, const Options& o, std::ostream& out, std
     for (const auto& f : files) err << "wrote " << f.path.string() << "\n";
     return 0;
   }
-  out << "{\"coordinates\":";
-  json_names(out, lin.coordinate_names());
+  out << (first_order ? "{\"states\":" : "{\"coordinates\":");
+  json_names(out, first_order ? d.state_names() : lin.coordinate_names());
   out << ",\n\"inputs\":";
-  json_names(out, lin.input_names());
+  json_names(out, first_order ? d.input_names() : lin.input_names());
   out << ",\n\"outputs\":";
-  json_names(out, lin.output_names());
+  json_names(out, first_order ? d.output_names() : lin.output_names());
   for (const auto& [name, A] : mats) {
     out << ",\n\"" << name << "\":";
     json_matrix(out, *A);

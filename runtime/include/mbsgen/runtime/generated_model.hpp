@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "mbsgen/runtime/error.hpp"
+#include "mbsgen/runtime/descriptor_model.hpp"
 #include "mbsgen/runtime/linear_model.hpp"
 
 namespace mbsgen {
@@ -59,6 +60,15 @@ struct ModelKernels {
   /// Optional (null: not recorded): the outputs z(y, ẏ) at any state (for outputs that depend
   /// on ÿ and u, at ÿ = 0 and u = 0: the static loads that `static` prints). Trailing.
   int (*outputs)(const double* y, const double* yd, const double* p, double* z) = nullptr;
+  /// Nonholonomic models (issue 16): the number of independent speeds, their names (the
+  /// coordinates whose rates they are), and the descriptor kernel E x' = A x + B u, z = C x at
+  /// (y0, yd0) with x = (the n_coordinates coordinates, the n_speeds speeds), column-major:
+  /// E, A n×n, B n×n_inputs, C n_outputs×n (n = n_coordinates + n_speeds). `linear`, `residual`
+  /// and `mass_matrix` are then null. Trailing.
+  int n_speeds = 0;
+  const char* const* speed_names = nullptr;
+  int (*descriptor)(const double* y0, const double* yd0, const double* p, double* E, double* A, double* B,
+                    double* C) = nullptr;
 };
 
 /// The first n entries of a kernel name array (null entries become "").
@@ -116,6 +126,14 @@ class GeneratedModel {
   /// set this way (a negative mass or inertia) would give numbers that only look like results.
   LinearModel linear_model(const OperatingPoint& op) const;
   LinearModel linear_model() const { return linear_model(operating_point()); }
+  /// True for a model with nonholonomic constraints, whose linear model is first order:
+  /// descriptor_model() (linear_model() throws).
+  bool is_descriptor() const { return k_.descriptor != nullptr; }
+  /// E, A, B, C of E x' = A x + B u, z = C x at the operating point, with x = (coordinates,
+  /// independent speeds): state names are the coordinates' and "NAME_dot" for the speeds. Throws
+  /// Error for a model that is not a descriptor model, NonFiniteError for a non-finite kernel value.
+  DescriptorModel descriptor_model(const OperatingPoint& op) const;
+  DescriptorModel descriptor_model() const { return descriptor_model(operating_point()); }
   /// The outputs z at the operating point (for outputs that depend on ÿ and u: at ÿ = 0 and
   /// u = 0, the static loads); empty when the kernels do not provide `outputs`.
   Eigen::VectorXd outputs(const OperatingPoint& op) const;
