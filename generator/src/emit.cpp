@@ -574,7 +574,14 @@ std::string nonholonomic_json(const Model& model, const Equations& eq, const Lin
       << ", \"component\": " << json_string(nh.equations[k].component) << "}";
   j << "], \"independent_speeds\": [" << names(lin.speeds, "_dot") << "], \"dependent_speeds\": ["
     << names(nh.dependent_speeds, "_dot") << "], \"chosen\": " << (nh.chosen ? "true" : "false")
-    << ",\n    \"state\": [" << names(lin.coordinates, "") << ", " << names(lin.speeds, "_dot") << "]}";
+    << ",\n    \"state\": [" << names(lin.coordinates, "") << ", " << names(lin.speeds, "_dot") << "]"
+    << ",\n    \"reduced_form\": ";
+  if (lin.reduced.exists)
+    j << "{\"coordinates\": [" << names(lin.reduced.coordinates, "") << "], \"kernel\": \"reduced\", \"matrices\": "
+      << "[\"M\", \"Q\", \"K\", \"B\"]}";
+  else
+    j << "null";
+  j << "}";
   return j.str();
 }
 
@@ -619,8 +626,9 @@ std::string header_text(const Model& model, const Equations& eq, const LinearEqu
   if (lin.descriptor)
     h << "// Nonholonomic constraints: the linear model is E x' = A x + B u, z = C x with x the " << f
       << " coordinates and\n// the " << lin.speeds.size() << " independent speeds (the rates of speed_names).\nenum { "
-      << out.id << "_n_speeds = " << lin.speeds.size() << " };\nextern const char* const " << out.id
-      << "_speed_names[];\n";
+      << out.id << "_n_speeds = " << lin.speeds.size() << ", " << out.id << "_n_reduced = " << lin.reduced.coordinates.size()
+      << " };\nextern const char* const " << out.id << "_speed_names[];\nextern const char* const " << out.id
+      << "_reduced_coordinate_names[];\n";
   h << "\n";
   for (const auto& k : out.kernels) h << k.signature << ";\n";
   h << "\n#ifdef __cplusplus\n}\n#endif\n";
@@ -751,6 +759,22 @@ Kernel descriptor_kernel(Equations& eq, const LinearEquations& lin, const std::v
   return k;
 }
 
+// reduced: M, Q, K (n×n), B (n×m) of the reduced second-order form (nonholonomic.hpp).
+Kernel reduced_kernel(Equations& eq, const LinearEquations& lin, const std::vector<ex>& y, const std::vector<ex>& yd,
+                      const std::vector<ex>& p) {
+  const ReducedForm& r = lin.reduced;
+  const std::size_t n = r.M.size(), m = eq.u.size();
+  std::vector<ex> none;
+  return {"reduced",
+          "reduced second-order form M q'' + Q q' + K q = B u of the descriptor model at (y0, yd0), q = "
+          "reduced_coordinate_names: M, Q, K (n×n), B (n×m), column-major",
+          {{"y0", y}, {"yd0", lin.at_rest ? none : yd}, {"p", p}},
+          {{"M", column_major(r.M, n, n), ""},
+           {"Q", column_major(r.Q, n, n), ""},
+           {"K", column_major(r.K, n, n), ""},
+           {"B", column_major(r.B, n, m), ""}}};
+}
+
 // The kernels of docs/generator.md, in emission order. With closed loops the coordinates y are
 // the tree's (n), the rates yd the independent ones, and the matrices those of the independent
 // coordinates (f); such kernels are wrapped (Kernel::wrapped).
@@ -769,6 +793,7 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
   std::vector<Kernel> kernels;
   if (lin.descriptor) {
     kernels.push_back(descriptor_kernel(eq, lin, y, yd, p));
+    if (lin.reduced.exists) kernels.push_back(reduced_kernel(eq, lin, y, yd, p));
   } else {
     second_order_kernels(eq, lin, y, yd, p, kernels);
   }
@@ -860,7 +885,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   }
   for (const auto& k : kernels) {
     const std::string as = k.name == "outputs_general"                          ? "outputs"
-                           : k.name == "output_terms" || k.name == "descriptor" ? "linear"
+                           : k.name == "output_terms" || k.name == "descriptor" || k.name == "reduced" ? "linear"
                                                                                 : k.name;
     if (!scene.emits(as)) continue;
     EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse);
@@ -922,6 +947,9 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
     std::vector<std::string> sn;
     for (std::size_t k : lin.speeds) sn.push_back(model.coordinates()[k].name);
     c << names_array("speed_names", sn);
+    std::vector<std::string> rn;
+    for (std::size_t k : lin.reduced.coordinates) rn.push_back(model.coordinates()[k].name);
+    c << names_array("reduced_coordinate_names", rn);
   }
   c << "extern \"C\" const double " << out.id << "_parameter_defaults[] = {";
   for (const auto& q : model.parameters()) c << format_double(q.value) << ", ";

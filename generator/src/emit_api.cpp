@@ -151,7 +151,8 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
   c << ", " << kernel("output_terms") << ", " << kernel("outputs");
   // Nonholonomic models: the independent speeds and the descriptor kernel.
   if (lin.descriptor)
-    c << ",\n      " << lin.speeds.size() << ", " << id << "_speed_names, " << kernel("descriptor");
+    c << ",\n      " << lin.speeds.size() << ", " << id << "_speed_names, " << kernel("descriptor") << ", "
+      << lin.reduced.coordinates.size() << ", " << id << "_reduced_coordinate_names, " << kernel("reduced");
   c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"

@@ -190,6 +190,7 @@ LinearEquations linearize(Equations& eq) {
     linearize_constrained(eq, lin);
     if (lin.descriptor) {
       lin.zeros = find_structural_zeros(eq, lin);
+      lin.reduced = reduced_form(lin);
       return lin;
     }
   } else {

@@ -596,3 +596,55 @@ void linearize_constrained(Equations& eq, LinearEquations& lin) {
 }
 
 }  // namespace mbsgen
+
+namespace mbsgen {
+
+ReducedForm reduced_form(const LinearEquations& lin) {
+  ReducedForm r;
+  const std::size_t f = lin.coordinates.size(), s = lin.speeds.size();
+  auto nonzero = [](const ZeroPattern& z, std::size_t i, std::size_t j) { return z[i][j] == EntryZero::nonzero; };
+  // speed_of[j]: the speed whose rate is coordinate position j, or s (none).
+  std::vector<std::size_t> speed_of(f, s), coordinate_of(s);
+  for (std::size_t k = 0; k < s; ++k) {
+    coordinate_of[k] = position_in(lin.coordinates, lin.speeds[k]);
+    speed_of[coordinate_of[k]] = k;
+  }
+  // Start from the speeds whose coordinate has a stiffness (a nonzero column in a dynamic row),
+  // then close under the couplings of their rows.
+  std::vector<char> kept(s, 0);
+  for (std::size_t k = 0; k < s; ++k)
+    for (std::size_t i = f; i < f + s; ++i) kept[k] = kept[k] || nonzero(lin.zeros.A, i, coordinate_of[k]);
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (std::size_t k = 0; k < s; ++k) {
+      if (!kept[k]) continue;
+      for (std::size_t row : {coordinate_of[k], f + k})
+        for (std::size_t j = 0; j < f + s; ++j) {
+          if (!nonzero(lin.zeros.A, row, j) && !nonzero(lin.zeros.E, row, j)) continue;
+          const std::size_t speed = j < f ? speed_of[j] : j - f;
+          if (speed == s) return r;  // coupled to a coordinate that is no speed's: no reduced form
+          if (!kept[speed]) kept[speed] = 1, grew = true;
+        }
+    }
+  }
+  std::vector<std::size_t> speeds;
+  for (std::size_t k = 0; k < s; ++k)
+    if (kept[k]) speeds.push_back(k);
+  if (speeds.empty()) return r;
+  r.exists = true;
+  const std::size_t n = speeds.size(), m = lin.Bx.empty() ? 0 : lin.Bx[0].size();
+  r.M = zeros(n, n), r.Q = zeros(n, n), r.K = zeros(n, n), r.B = zeros(n, m);
+  for (std::size_t a = 0; a < n; ++a) {
+    r.coordinates.push_back(lin.speeds[speeds[a]]);
+    const std::size_t row = f + speeds[a];
+    for (std::size_t b = 0; b < n; ++b) {
+      r.M[a][b] = lin.E[row][f + speeds[b]];
+      r.Q[a][b] = lin.A[row][f + speeds[b]].is_zero() ? ex(0) : ex(-lin.A[row][f + speeds[b]]);
+      r.K[a][b] = lin.A[row][coordinate_of[speeds[b]]].is_zero() ? ex(0) : ex(-lin.A[row][coordinate_of[speeds[b]]]);
+    }
+    for (std::size_t u = 0; u < m; ++u) r.B[a][u] = lin.Bx[row][u];
+  }
+  return r;
+}
+
+}  // namespace mbsgen

@@ -705,6 +705,12 @@ DescriptorEigenSolver& DescriptorEigenSolver::compute_named(
   const double floor = options_.backward_error_floor > 0    ? options_.backward_error_floor
                        : options_.backward_error_floor == 0 ? 100.0 * static_cast<double>(n) * kU
                                                             : 0.0;
+  // An equation that is 0 = 0 (a zero row of both E and A) makes det(λE − A) ≡ 0.
+  for (Index i = 0; i < n; ++i)
+    if ((E.row(i).array() == 0.0).all() && (A.row(i).array() == 0.0).all())
+      throw SingularSystemError("DescriptorEigenSolver::compute: the pencil λE − A is singular (det ≡ 0): equation " +
+                                std::to_string(i + 1) + " (the row of state '" + names[static_cast<std::size_t>(i)] +
+                                "') is zero in both E and A");
   Deflation d;
   d.compute(E, A, names);
   modes_ = zero_modes(E, A, d, nA, zero_columns_);

@@ -179,6 +179,21 @@ DescriptorModel GeneratedModel::descriptor_model(const OperatingPoint& op) const
                          name_list(k_.output_units, k_.n_outputs));
 }
 
+LinearModel GeneratedModel::reduced_model(const OperatingPoint& op) const {
+  if (!k_.reduced)
+    throw Error("GeneratedModel::reduced_model: model '" + std::string(k_.model) + "' has no reduced second-order form");
+  const Eigen::Index f = size(), n = k_.n_reduced, m = k_.n_inputs;
+  if (op.y0.size() != f || op.yd0.size() != f)
+    throw DimensionError("GeneratedModel::reduced_model: operating point of size " + std::to_string(op.y0.size()) + "/" +
+                         std::to_string(op.yd0.size()) + " for a model with " + std::to_string(f) + " coordinates");
+  Eigen::MatrixXd M(n, n), Q(n, n), K(n, n), B(n, m);
+  double dummy[1];
+  check_status(k_.reduced(op.y0.data(), op.yd0.data(), p_.data(), M.data(), Q.data(), K.data(), B.size() ? B.data() : dummy),
+               "reduced", k_.model);
+  return LinearModel(M, Q, K, B, Eigen::MatrixXd(), Eigen::MatrixXd(), name_list(k_.reduced_coordinate_names, k_.n_reduced),
+                     name_list(k_.input_names, k_.n_inputs));
+}
+
 LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
   if (!k_.linear)
     throw Error("model '" + std::string(k_.model) + "' has nonholonomic constraints: its linear model is first order, "

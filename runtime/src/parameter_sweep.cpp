@@ -64,14 +64,13 @@ std::complex<double> rightmost(const SweepPoint& p) {
 // Whether the computed spectrum grows, by the signs of the real parts themselves (no error
 // bounds): an eigenvalue counts when |λ| exceeds 100·u of the largest (below that it is the
 // rounding of a zero, such as a rolling disk's neighbouring steady turn, whose normwise error
-// bound is no guide), and grows when Re λ exceeds 100·u·|λ| (the rounding of a pair on the
-// imaginary axis, which a gyroscopic system keeps there).
+// bound is no guide), and grows when Re λ > 0.
 bool grows(const SweepPoint& p) {
   const double u = std::numeric_limits<double>::epsilon();
   double scale = 0;
   for (const auto& l : p.eigenvalues) scale = std::max(scale, std::abs(l));
   for (const auto& l : p.eigenvalues)
-    if (std::abs(l) > 100 * u * scale && l.real() > 100 * u * std::abs(l)) return true;
+    if (std::abs(l) > 100 * u * scale && l.real() > 0) return true;
   return false;
 }
 

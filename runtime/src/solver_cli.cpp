@@ -322,6 +322,17 @@ int run_matrices(const ModelKernels& k, const Options& o, std::ostream& out, std
     out << ",\n\"" << name << "\":";
     json_matrix(out, *A);
   }
+  if (model.has_reduced_form()) {  // e.g. the bicycle's lean and steer: M q'' + Q q' + K q = B u
+    const LinearModel r = model.reduced_model();
+    out << ",\n\"reduced\":{\"coordinates\":";
+    json_names(out, r.coordinate_names());
+    for (const auto& [name, A] : std::vector<std::pair<const char*, const Eigen::MatrixXd*>>{
+             {"M", &r.M()}, {"Q", &r.Q()}, {"K", &r.K()}, {"B", &r.B()}}) {
+      out << ",\n  \"" << name << "\":";
+      json_matrix(out, *A);
+    }
+    out << "}";
+  }
   out << "}\n";
   return 0;
 }

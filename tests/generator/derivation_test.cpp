@@ -116,7 +116,9 @@ TEST(StructuralZeros, HeavyTopPatternFollowsFromTheLagrangian) {
   // The manifest records the pattern.
   const GeneratedCode code = emit(model, eq, lin, EmitOptions{});
   EXPECT_NE(code.manifest.find("\"K\": [\"0o0\", \"0x0\", \"0o0\"]"), std::string::npos) << code.manifest;
-  EXPECT_NE(code.source.find("  if (y0[0] == op0 && y0[1] == op1 && y0[2] == op2 && yd0[0] == op3 && yd0[1] == op4 && yd0[2] == op5) {"),
+  EXPECT_NE(code.source.find("  if (at_operating_point(y0[0], op0) && at_operating_point(y0[1], op1) && "
+                             "at_operating_point(y0[2], op2) && at_operating_point(yd0[0], op3) && "
+                             "at_operating_point(yd0[1], op4) && at_operating_point(yd0[2], op5)) {"),
             std::string::npos);
 }
 

@@ -278,19 +278,16 @@ TEST(DescriptorModes, SingularPencilNamesTheState) {
   EXPECT_NE(message_of([&] { s.compute(dep); }).find("(psi, s) have linearly dependent columns"),
             std::string::npos)
       << message_of([&] { s.compute(dep); });
-  // No zero column, but the second equation is 0 = 0 in both E and A: det(λE − A) ≡ 0, which QZ
-  // reports as α = β = 0.
+  // The second equation is 0 = 0 in both E and A: det(λE − A) ≡ 0, named before any deflation.
   MatrixXd E2(2, 2), A2(2, 2);
-  // At the second level: x2 enters only the first equation, which deflating x1 removes;
-  // det([[λ, −1], [0, 0]]) ≡ 0.
   E2 << 1, 0, 0, 0;
   A2 << 0, 1, 0, 0;
-  EXPECT_NE(message_of([&] { s.compute(E2, A2); }).find("state 'x2' has a zero column in both E "
-                                                        "and A in the equations left"),
+  EXPECT_NE(message_of([&] { s.compute(E2, A2); }).find("equation 2 (the row of state 'x2') is zero in both E and A"),
             std::string::npos)
       << message_of([&] { s.compute(E2, A2); });
-  E2 << 1, 1, 0, 0;
-  A2 << 2, 1, 0, 0;
+  // Two equal equations, no zero row or column: det ≡ 0, which QZ reports as α = β = 0.
+  E2 << 1, 1, 1, 1;
+  A2 << 2, 1, 2, 1;
   EXPECT_NE(message_of([&] { s.compute(E2, A2); }).find("α = β = 0"), std::string::npos)
       << message_of([&] { s.compute(E2, A2); });
 }

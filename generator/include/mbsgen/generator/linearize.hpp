@@ -30,6 +30,8 @@ struct LinearEquations {
   /// and M, Q, K, B, C_y, C_v above are empty.
   bool descriptor = false;
   ExMatrix E, A, Bx, Cx;
+  /// The reduced second-order form of the descriptor model, where it exists (nonholonomic.hpp).
+  ReducedForm reduced;
   ExMatrix M, Q, K, B, Cy, Cv;  ///< f×f, f×f, f×f, f×m, r×f, r×f (expressions in y, ẏ, p)
   ExMatrix D, G, Ks, N;         ///< sym Q, skew Q, sym K, skew K
   /// Outputs that depend on accelerations and inputs (reaction forces, reactions.hpp):

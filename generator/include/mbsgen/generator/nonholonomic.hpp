@@ -64,6 +64,21 @@ struct Nonholonomic {
   SymbolicLU lu;        ///< of B_d = (A T)_d
 };
 
+/// The reduced second-order form of a descriptor model, where it exists: coordinates q whose rates
+/// are independent speeds, closed under the couplings of the linear model at the operating point
+/// (their rows of E and A have exact zeros outside q and q̇), so that
+///   M q̈ + Q q̇ + K q = B u
+/// holds on its own and the rest of the spectrum (ignorable coordinates, decoupled speeds) is
+/// block triangular to it: for the bicycle, lean and steer (Meijaard et al. 2007, eq. 5.3).
+struct ReducedForm {
+  bool exists = false;
+  std::vector<std::size_t> coordinates;  ///< model coordinate indices, ascending
+  ExMatrix M, Q, K, B;                   ///< from the descriptor matrices (rows of the speeds)
+};
+
+/// The reduced form of lin's descriptor model, decided on its exact zeros (lin.zeros).
+ReducedForm reduced_form(const LinearEquations& lin);
+
 /// Builds the velocity constraints of a derived model (after close_loops), chooses or checks the
 /// independent speeds at the operating point with the default parameter values, and checks that
 /// the operating point's rates satisfy the constraints. Inactive without such constraints.

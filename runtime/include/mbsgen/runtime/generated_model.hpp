@@ -69,6 +69,12 @@ struct ModelKernels {
   const char* const* speed_names = nullptr;
   int (*descriptor)(const double* y0, const double* yd0, const double* p, double* E, double* A, double* B,
                     double* C) = nullptr;
+  /// Where it exists, the reduced second-order form M q'' + Q q' + K q = B u of the descriptor
+  /// model on n_reduced of the coordinates (a bicycle's lean and steer), column-major. Trailing.
+  int n_reduced = 0;
+  const char* const* reduced_coordinate_names = nullptr;
+  int (*reduced)(const double* y0, const double* yd0, const double* p, double* M, double* Q, double* K,
+                 double* B) = nullptr;
 };
 
 /// The first n entries of a kernel name array (null entries become "").
@@ -134,6 +140,12 @@ class GeneratedModel {
   /// Error for a model that is not a descriptor model, NonFiniteError for a non-finite kernel value.
   DescriptorModel descriptor_model(const OperatingPoint& op) const;
   DescriptorModel descriptor_model() const { return descriptor_model(operating_point()); }
+  /// True when the descriptor model has a reduced second-order form (reduced_model()).
+  bool has_reduced_form() const { return k_.reduced != nullptr; }
+  /// M, Q, K, B of the reduced second-order form at the operating point, its coordinates named
+  /// (outputs: the coordinates). Throws Error when the model has none.
+  LinearModel reduced_model(const OperatingPoint& op) const;
+  LinearModel reduced_model() const { return reduced_model(operating_point()); }
   /// The outputs z at the operating point (for outputs that depend on ÿ and u: at ÿ = 0 and
   /// u = 0, the static loads); empty when the kernels do not provide `outputs`.
   Eigen::VectorXd outputs(const OperatingPoint& op) const;
