@@ -81,6 +81,13 @@ bool grows(const SweepPoint& p) {
 StabilityBoundary refine(GeneratedModel& model, const std::string& parameter, SweepPoint a, SweepPoint b,
                          const SweepOptions& options) {
   const bool a_unstable = a.abscissa > 0;
+  // The decided verdicts (with error bounds) bracket the crossing only to the width of the band
+  // where the crossing eigenvalue is within its bound; the computed signs may change just outside
+  // the bracket (the bicycle's capsize root at 1,000 speeds). Widen by the bracket's width until
+  // the signs at its ends differ.
+  const double step = b.value - a.value;
+  for (int k = 0; k < 64 && grows(a) != a_unstable; ++k) a = at(model, parameter, a.value - step);
+  for (int k = 0; k < 64 && grows(b) == a_unstable; ++k) b = at(model, parameter, b.value + step);
   for (int i = 0; i < 200; ++i) {
     const double width = std::abs(b.value - a.value);
     if (width <= options.relative_tolerance * std::max(1.0, std::abs(a.value))) break;

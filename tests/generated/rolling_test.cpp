@@ -80,6 +80,14 @@ TEST(WhippleBicycle, EigenvaluesMatchTable2) {
 
 TEST(WhippleBicycle, WeaveAndCapsizeSpeeds) {
   GeneratedModel model(whipple_benchmark::kernels());
+  // 1,000 speeds too: near the capsize speed the root is within its (normwise) error bound over a
+  // band wider than the grid's step, and the refinement must leave the bracket that band gives.
+  for (int points : {21, 1000}) {
+    const mbsgen::SweepResult r = mbsgen::sweep_parameter(model, "v", 0, 10, points);
+    ASSERT_EQ(r.boundaries.size(), 2u) << points;
+    EXPECT_NEAR(r.boundaries[0].value, 4.29238253634111, 1e-10) << points;
+    EXPECT_NEAR(r.boundaries[1].value, 6.02426201538837, 1e-10) << points;
+  }
   const mbsgen::SweepResult r = mbsgen::sweep_parameter(model, "v", 0, 10, 21);
   ASSERT_EQ(r.boundaries.size(), 2u);
   // The weave pair crosses into the left half-plane at v_w, the capsize root into the right at v_c
