@@ -473,30 +473,6 @@ double worst(const std::vector<Raw>& v, bool componentwise = false) {
   return e;
 }
 
-/// The verdict of Stability (quadratic_eigen.hpp) from the modes' error bounds; infinite
-/// eigenvalues do not count. The rules of QuadraticEigenSolver::stability().
-Stability stability_verdict(const std::vector<Mode>& modes) {
-  bool undecided = false, on_axis = false;
-  for (const Mode& m : modes) {
-    if (m.kind == EigenvalueKind::infinite) continue;
-    if (m.kind == EigenvalueKind::zero) {
-      on_axis = true;
-      continue;
-    }
-    const double re = m.lambda.real();
-    if (m.zero_within_bound || !(m.error_bound < kInf)) {
-      undecided = true;
-    } else if (re > m.error_bound) {
-      return Stability::unstable;
-    } else if (re == 0.0) {
-      on_axis = true;
-    } else if (re >= -m.error_bound) {
-      undecided = true;
-    }
-  }
-  if (undecided) return Stability::undecided;
-  return on_axis ? Stability::marginal : Stability::stable;
-}
 
 int kind_order(EigenvalueKind k) {
   return k == EigenvalueKind::zero ? 0 : (k == EigenvalueKind::finite ? 1 : 2);
@@ -746,7 +722,7 @@ DescriptorEigenSolver& DescriptorEigenSolver::compute_named(
     }
   }
   sort_modes(modes_);
-  stability_ = stability_verdict(modes_);
+  stability_ = stability_of(modes_);
   info_ = Eigen::Success;
   return *this;
 }

@@ -101,29 +101,6 @@ const char* kind_label(const Mode& mode) {
 
 namespace {
 
-/// The verdict of Stability from the modes' error bounds; infinite eigenvalues do not count.
-Stability stability_verdict(const std::vector<Mode>& modes) {
-  bool undecided = false, on_axis = false;
-  for (const Mode& m : modes) {
-    if (m.kind == EigenvalueKind::infinite) continue;
-    if (m.kind == EigenvalueKind::zero) {
-      on_axis = true;
-      continue;
-    }
-    const double re = m.lambda.real();
-    if (m.zero_within_bound || !(m.error_bound < kInf)) {
-      undecided = true;
-    } else if (re > m.error_bound) {
-      return Stability::unstable;
-    } else if (re == 0.0) {
-      on_axis = true;
-    } else if (re >= -m.error_bound) {
-      undecided = true;
-    }
-  }
-  if (undecided) return Stability::undecided;
-  return on_axis ? Stability::marginal : Stability::stable;
-}
 
 }  // namespace
 
@@ -198,7 +175,7 @@ QuadraticEigenSolver& QuadraticEigenSolver::compute(const Eigen::MatrixXd& M,
   if (options_.symmetric_fast_path && check.is_symmetric_undamped()) compute_symmetric(M, K, done);
   if (!done) compute_general(M, Qf, K);
   finish(M, Qf, K);
-  stability_ = stability_verdict(modes_);
+  stability_ = stability_of(modes_);
   info_ = Eigen::Success;
   return *this;
 }
@@ -809,6 +786,29 @@ void QuadraticEigenSolver::finish(const Eigen::MatrixXd& M, const Eigen::MatrixX
       ++k;
     }
   }
+}
+
+Stability stability_of(const std::vector<Mode>& modes) {
+  bool undecided = false, on_axis = false;
+  for (const Mode& m : modes) {
+    if (m.kind == EigenvalueKind::infinite) continue;
+    if (m.kind == EigenvalueKind::zero) {
+      on_axis = true;
+      continue;
+    }
+    const double re = m.lambda.real();
+    if (m.zero_within_bound || !(m.error_bound < kInf)) {
+      undecided = true;
+    } else if (re > m.error_bound) {
+      return Stability::unstable;
+    } else if (re == 0.0) {
+      on_axis = true;
+    } else if (re >= -m.error_bound) {
+      undecided = true;
+    }
+  }
+  if (undecided) return Stability::undecided;
+  return on_axis ? Stability::marginal : Stability::stable;
 }
 
 }  // namespace mbsgen

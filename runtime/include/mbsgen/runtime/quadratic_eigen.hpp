@@ -39,6 +39,11 @@ enum class Stability {
 /// "stable", "unstable", "marginal" or "undecided".
 const char* to_string(Stability verdict);
 
+struct Mode;
+/// The verdict of Stability from modes' kinds and error bounds (infinite eigenvalues do not
+/// count): what QuadraticEigenSolver::stability() and DescriptorEigenSolver::stability() report.
+Stability stability_of(const std::vector<Mode>& modes);
+
 /// One eigenpair of λ²M + λQ + K.
 struct Mode {
   /// Reported eigenvalue λ (1/s): exactly 0 for kind zero, +∞ (real part) for kind infinite.
