@@ -24,6 +24,7 @@ extern "C" const char* const rolling_disk_input_names[] = {nullptr};
 extern "C" const char* const rolling_disk_output_names[] = {"lean", nullptr};
 extern "C" const char* const rolling_disk_speed_names[] = {"q1", "q2", "q3", nullptr};
 extern "C" const char* const rolling_disk_reduced_coordinate_names[] = {"q1", "q2", nullptr};
+extern "C" const char* const rolling_disk_reduced_part_names[] = {nullptr};
 extern "C" const double rolling_disk_parameter_defaults[] = {1.0, 1.0, 1.0, 1.0, 0.0};
 
 // descriptor model E x' = A x + B u, z = C x at (y0, yd0) with x = (coordinates, independent speeds): E, A (n×n), B (n×m), C (r×n), column-major; yd0 entries of dependent speeds are not used

@@ -39,9 +39,10 @@ extern const char* const rolling_disk_input_names[];
 extern const char* const rolling_disk_output_names[];
 // Nonholonomic constraints: the linear model is E x' = A x + B u, z = C x with x the 5 coordinates and
 // the 3 independent speeds (the rates of speed_names).
-enum { rolling_disk_n_speeds = 3, rolling_disk_n_reduced = 2 };
+enum { rolling_disk_n_speeds = 3, rolling_disk_n_reduced = 2, rolling_disk_n_reduced_parts = 0 };
 extern const char* const rolling_disk_speed_names[];
 extern const char* const rolling_disk_reduced_coordinate_names[];
+extern const char* const rolling_disk_reduced_part_names[];
 
 int rolling_disk_descriptor(const double* y0, const double* yd0, const double* p, double* E, double* A, double* B, double* C);
 int rolling_disk_reduced(const double* y0, const double* yd0, const double* p, double* M, double* Q, double* K, double* B);

@@ -25,7 +25,7 @@ const mbsgen::ModelKernels& kernels() {
       rolling_disk_input_names, input_units, rolling_disk_output_names, output_units,
       &rolling_disk_operating_point, nullptr, nullptr, nullptr,
       0, false, "0.1.0", nullptr, &rolling_disk_outputs,
-      3, rolling_disk_speed_names, &rolling_disk_descriptor, 2, rolling_disk_reduced_coordinate_names, &rolling_disk_reduced};
+      3, rolling_disk_speed_names, &rolling_disk_descriptor, 2, rolling_disk_reduced_coordinate_names, &rolling_disk_reduced, 0, rolling_disk_reduced_part_names, nullptr};
   return k;
 }
 

@@ -577,8 +577,18 @@ std::string nonholonomic_json(const Model& model, const Equations& eq, const Lin
     << ",\n    \"state\": [" << names(lin.coordinates, "") << ", " << names(lin.speeds, "_dot") << "]"
     << ",\n    \"reduced_form\": ";
   if (lin.reduced.exists)
+  {
     j << "{\"coordinates\": [" << names(lin.reduced.coordinates, "") << "], \"kernel\": \"reduced\", \"matrices\": "
-      << "[\"M\", \"Q\", \"K\", \"B\"]}";
+      << "[\"M\", \"Q\", \"K\", \"B\"], \"parts\": [";
+    const auto& parts = model.reduced_coefficients();
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      std::ostringstream m;
+      m << parts[i].monomial;
+      j << (i ? ", " : "") << "{\"name\": " << json_string(parts[i].name) << ", \"of\": \"" << parts[i].matrix
+        << "\", \"per\": " << json_string(m.str()) << "}";
+    }
+    j << "]}";
+  }
   else
     j << "null";
   j << "}";
@@ -627,8 +637,9 @@ std::string header_text(const Model& model, const Equations& eq, const LinearEqu
     h << "// Nonholonomic constraints: the linear model is E x' = A x + B u, z = C x with x the " << f
       << " coordinates and\n// the " << lin.speeds.size() << " independent speeds (the rates of speed_names).\nenum { "
       << out.id << "_n_speeds = " << lin.speeds.size() << ", " << out.id << "_n_reduced = " << lin.reduced.coordinates.size()
-      << " };\nextern const char* const " << out.id << "_speed_names[];\nextern const char* const " << out.id
-      << "_reduced_coordinate_names[];\n";
+      << ", " << out.id << "_n_reduced_parts = " << lin.reduced.named.size() << " };\nextern const char* const " << out.id
+      << "_speed_names[];\nextern const char* const " << out.id << "_reduced_coordinate_names[];\nextern const char* const "
+      << out.id << "_reduced_part_names[];\n";
   h << "\n";
   for (const auto& k : out.kernels) h << k.signature << ";\n";
   h << "\n#ifdef __cplusplus\n}\n#endif\n";
@@ -794,6 +805,15 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
   if (lin.descriptor) {
     kernels.push_back(descriptor_kernel(eq, lin, y, yd, p));
     if (lin.reduced.exists) kernels.push_back(reduced_kernel(eq, lin, y, yd, p));
+    if (!lin.reduced.named.empty()) {
+      std::vector<ex> parts;
+      for (const ExMatrix& C : lin.reduced.named)
+        for (const ex& x : column_major(C, C.size(), C.size())) parts.push_back(x);
+      kernels.push_back({"reduced_parts",
+                         "the model's named parts of the reduced form at the operating point (reduced_part_names), "
+                         "each n×n column-major, one after the other",
+                         {{"y0", y}, {"p", p}}, {{"C", parts, ""}}});
+    }
   } else {
     second_order_kernels(eq, lin, y, yd, p, kernels);
   }
@@ -885,7 +905,9 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   }
   for (const auto& k : kernels) {
     const std::string as = k.name == "outputs_general"                          ? "outputs"
-                           : k.name == "output_terms" || k.name == "descriptor" || k.name == "reduced" ? "linear"
+                           : k.name == "output_terms" || k.name == "descriptor" || k.name == "reduced" ||
+                                     k.name == "reduced_parts"
+                               ? "linear"
                                                                                 : k.name;
     if (!scene.emits(as)) continue;
     EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse);
@@ -950,6 +972,9 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
     std::vector<std::string> rn;
     for (std::size_t k : lin.reduced.coordinates) rn.push_back(model.coordinates()[k].name);
     c << names_array("reduced_coordinate_names", rn);
+    std::vector<std::string> parts;
+    for (const auto& part : model.reduced_coefficients()) parts.push_back(part.name);
+    c << names_array("reduced_part_names", parts);
   }
   c << "extern \"C\" const double " << out.id << "_parameter_defaults[] = {";
   for (const auto& q : model.parameters()) c << format_double(q.value) << ", ";

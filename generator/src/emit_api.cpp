@@ -152,7 +152,8 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
   // Nonholonomic models: the independent speeds and the descriptor kernel.
   if (lin.descriptor)
     c << ",\n      " << lin.speeds.size() << ", " << id << "_speed_names, " << kernel("descriptor") << ", "
-      << lin.reduced.coordinates.size() << ", " << id << "_reduced_coordinate_names, " << kernel("reduced");
+      << lin.reduced.coordinates.size() << ", " << id << "_reduced_coordinate_names, " << kernel("reduced") << ", "
+      << lin.reduced.named.size() << ", " << id << "_reduced_part_names, " << kernel("reduced_parts");
   c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"

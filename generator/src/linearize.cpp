@@ -191,6 +191,7 @@ LinearEquations linearize(Equations& eq) {
     if (lin.descriptor) {
       lin.zeros = find_structural_zeros(eq, lin);
       lin.reduced = reduced_form(lin);
+      name_reduced_parts(eq, lin);
       return lin;
     }
   } else {

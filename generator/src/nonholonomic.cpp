@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <map>
 #include <set>
+#include <sstream>
 
 namespace mbsgen {
 
@@ -645,6 +646,130 @@ ReducedForm reduced_form(const LinearEquations& lin) {
     for (std::size_t u = 0; u < m; ++u) r.B[a][u] = lin.Bx[row][u];
   }
   return r;
+}
+
+}  // namespace mbsgen
+
+namespace mbsgen {
+
+namespace {
+
+// The parameters and powers of a monomial p1^k1 p2^k2 ... (empty for 1); false when it is not one.
+bool monomial_powers(const Equations& eq, const ex& m, std::vector<std::pair<ex, int>>& out) {
+  auto parameter = [&](const ex& x) { return std::find(eq.p.begin(), eq.p.end(), x) != eq.p.end(); };
+  auto factor = [&](const ex& f) {
+    if (GiNaC::is_a<GiNaC::symbol>(f) && parameter(f)) return out.push_back({f, 1}), true;
+    if (GiNaC::is_a<GiNaC::power>(f) && GiNaC::is_a<GiNaC::symbol>(f.op(0)) && parameter(f.op(0)) &&
+        f.op(1).info(GiNaC::info_flags::posint))
+      return out.push_back({f.op(0), GiNaC::ex_to<GiNaC::numeric>(f.op(1)).to_int()}), true;
+    return false;
+  };
+  if (m.is_equal(1)) return true;
+  if (GiNaC::is_a<GiNaC::mul>(m)) {
+    for (std::size_t i = 0; i < m.nops(); ++i)
+      if (!factor(m.op(i))) return false;
+    return true;
+  }
+  return factor(m);
+}
+
+// The coefficient of `powers` in the expression e (Taylor coefficient at zero of `zero`).
+ex taylor_coefficient(Program& prog, ex e, const std::vector<std::pair<ex, int>>& powers, const GiNaC::exmap& zero) {
+  GiNaC::numeric factorial = 1;
+  for (const auto& [p, k] : powers)
+    for (int i = 0; i < k; ++i) e = prog.diff(e, GiNaC::ex_to<GiNaC::symbol>(p)), factorial *= i + 1;
+  Program::Substitution at_zero(zero);
+  return prog.define(prog.substitute(e, at_zero) / factorial);
+}
+
+// Each matrix with named parts equals their sum, Σ monomial_i · C_i, at two pseudo-random points.
+void check_named_parts(Equations& eq, const LinearEquations& lin, Program::Substitution& at_op) {
+  const auto& parts = eq.model->reduced_coefficients();
+  Program& prog = eq.program;
+  const std::size_t n = lin.reduced.M.size();
+  for (char c : {'M', 'Q', 'K'}) {
+    const ExMatrix& X = c == 'M' ? lin.reduced.M : c == 'Q' ? lin.reduced.Q : lin.reduced.K;
+    std::vector<ex> remainder, size;
+    bool named = false;
+    for (std::size_t a = 0; a < n; ++a)
+      for (std::size_t b = 0; b < n; ++b) {
+        ex r = X[a][b].is_zero() ? ex(0) : prog.substitute(X[a][b], at_op);
+        size.push_back(r);
+        for (std::size_t i = 0; i < parts.size(); ++i)
+          if (parts[i].matrix == c) named = true, r -= parts[i].monomial * lin.reduced.named[i][a][b];
+        remainder.push_back(prog.define(r));
+      }
+    if (!named) continue;
+    const long digits = GiNaC::Digits;
+    GiNaC::Digits = detail::PointEvaluator::kDigits;
+    std::uint64_t state = 0x51ed2701f3a5c9b3ULL;
+    for (int point = 0; point < 2; ++point) {
+      const GiNaC::exmap values = detail::sample_point(eq, lin, state, false);
+      const auto r = detail::PointEvaluator(prog, values).evaluate(remainder);
+      const auto x = detail::PointEvaluator(prog, values).evaluate(size);
+      GiNaC::numeric worst = 0, scale = 0;
+      for (std::size_t k = 0; k < r.size(); ++k) worst = std::max(worst, GiNaC::abs(r[k])), scale = std::max(scale, GiNaC::abs(x[k]));
+      if (worst > scale * GiNaC::numeric(10).power(-30)) {
+        GiNaC::Digits = digits;
+        std::string list;
+        for (const auto& p : parts)
+          if (p.matrix == c) {
+            std::ostringstream m;
+            m << p.monomial;
+            list += (list.empty() ? "" : " + ") + p.name + "·" + m.str();
+          }
+        throw ModelError(parts.front().where, std::string("the reduced ") + c + " is not the sum of its named parts (" + list +
+                                                  "): a remainder of " + format(worst.to_double()) + " of " +
+                                                  format(scale.to_double()) + " at a pseudo-random point");
+      }
+    }
+    GiNaC::Digits = digits;
+  }
+}
+
+}  // namespace
+
+void name_reduced_parts(Equations& eq, LinearEquations& lin) {
+  const Model& model = *eq.model;
+  const auto& parts = model.reduced_coefficients();
+  if (parts.empty()) return;
+  if (!lin.reduced.exists)
+    throw ModelError(parts.front().where, "the model names parts of its reduced second-order form, but it has none (no "
+                                          "coordinates whose equations close on themselves)");
+  Program& prog = eq.program;
+  // The operating point: the independent coordinates' positions and every rate (in parameters).
+  GiNaC::exmap op;
+  for (std::size_t k = 0; k < eq.y.size(); ++k) {
+    if (!std::binary_search(eq.loops.dependent.begin(), eq.loops.dependent.end(), k)) op[eq.y[k]] = lin.y0[k];
+    op[eq.yd[k]] = lin.yd0[k];
+  }
+  Program::Substitution at_op(op);
+  std::map<char, GiNaC::exmap> zero;  // per matrix: its monomials' parameters at 0
+  std::vector<std::vector<std::pair<ex, int>>> powers(parts.size());
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (!monomial_powers(eq, parts[i].monomial, powers[i]))
+      throw ModelError(parts[i].where, "reduced-form part '" + parts[i].name +
+                                           "': the monomial must be a product of powers of parameters (v, g, v^2, g*v)");
+    for (const auto& [p, k] : powers[i]) {
+      zero[parts[i].matrix][p] = 0;
+      for (const auto& e : eq.loops.equations)
+        if (!prog.diff(e.phi, GiNaC::ex_to<GiNaC::symbol>(p)).is_zero())
+          throw ModelError(parts[i].where, "reduced-form part '" + parts[i].name + "': constraint '" + e.constraint +
+                                               "' depends on the monomial's parameter, so the matrices are not polynomials in it");
+    }
+  }
+  auto matrix = [&](char c) -> const ExMatrix& { return c == 'M' ? lin.reduced.M : c == 'Q' ? lin.reduced.Q : lin.reduced.K; };
+  const std::size_t n = lin.reduced.M.size();
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    ExMatrix C = zeros(n, n);
+    for (std::size_t a = 0; a < n; ++a)
+      for (std::size_t b = 0; b < n; ++b) {
+        const ex x = matrix(parts[i].matrix)[a][b];
+        if (!x.is_zero()) C[a][b] = taylor_coefficient(prog, prog.define(prog.substitute(x, at_op)), powers[i], zero[parts[i].matrix]);
+      }
+    lin.reduced.named.push_back(C);
+  }
+  check_named_parts(eq, lin, at_op);
 }
 
 }  // namespace mbsgen

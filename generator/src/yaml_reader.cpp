@@ -864,6 +864,7 @@ class Reader {
   void read_constraint(const YAML::Node& n, std::map<std::string, int>& counters);
   void read_rolling(const Fields& f, const YAML::Node& n, Constraint& c);
   void read_velocity_constraints(const Entry* e);
+  void read_reduced_form(const Entry& e);
   void read_operating_point(const Entry& e);
   OperatingPointOverride read_operating_point_values(const YAML::Node& n, const std::string& what);
   void read_scene(const YAML::Node& n);
@@ -934,7 +935,7 @@ Model Reader::read_model() {
   const Fields top = fields(root, "the model file",
                             {"model", "parameters", "coordinates", "inputs", "bodies", "markers",
                              "forces", "constraints", "independent_coordinates", "nonholonomic",
-                             "independent_speeds", "outputs",
+                             "independent_speeds", "reduced_form", "outputs",
                              "operating_point", "scenes"});
 
   const Entry& name_entry = require(top, "model", root, "the model file");
@@ -985,6 +986,7 @@ Model Reader::read_model() {
     model.set_independent_coordinates(std::move(names));
   }
   read_velocity_constraints(find(top, "nonholonomic"));
+  if (const Entry* e = find(top, "reduced_form")) read_reduced_form(*e);
   if (const Entry* e = find(top, "independent_speeds")) {
     std::vector<SceneItem> names = items(*e, "independent_speeds");
     for (const auto& item : names)
@@ -1465,6 +1467,36 @@ void Reader::read_velocity_constraints(const Entry* e) {
     used_names_.insert(v.name);
     model_->add_velocity_constraint(v);
   }
+}
+
+// `reduced_form: {NAME: MATRIX, NAME: MATRIX/MONOMIAL, ...}`: named parts of the reduced
+// second-order form, MATRIX one of M, Q, K and MONOMIAL a product of powers of parameters
+// (C1: Q/v is the coefficient of v in Q).
+void Reader::read_reduced_form(const Entry& e) {
+  const YAML::Node& n = value(e);
+  if (!n.IsMap()) fail(n, "expected a map NAME: MATRIX or NAME: MATRIX/MONOMIAL for the reduced form, got " + describe(n));
+  std::vector<NamedCoefficient> out;
+  for (auto it = n.begin(); it != n.end(); ++it) {
+    NamedCoefficient c;
+    c.name = scalar(it->first, "a matrix name");
+    if (!is_identifier(c.name)) fail(it->first, "a reduced-form matrix name must be an identifier, got '" + c.name + "'");
+    c.where = loc(it->second);
+    const std::string text = scalar(it->second, "a reduced-form part");
+    const std::size_t slash = text.find('/');
+    const std::string matrix = text.substr(0, slash);
+    if (matrix != "M" && matrix != "Q" && matrix != "K")
+      fail(it->second, "a reduced-form part is M, Q or K, optionally per a monomial of parameters (K/g, Q/v), got '" +
+                           text + "'");
+    c.matrix = matrix[0];
+    if (slash != std::string::npos) {
+      const YAML::Node monomial(text.substr(slash + 1));
+      c.monomial = expr(monomial, "a reduced-form monomial", Scope::parameters);
+    }
+    for (const auto& other : out)
+      if (other.name == c.name) fail(it->first, "reduced-form matrix '" + c.name + "' is named twice");
+    out.push_back(c);
+  }
+  model_->set_reduced_coefficients(std::move(out));
 }
 
 void Reader::read_operating_point(const Entry& e) {

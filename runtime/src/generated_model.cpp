@@ -194,6 +194,21 @@ LinearModel GeneratedModel::reduced_model(const OperatingPoint& op) const {
                      name_list(k_.input_names, k_.n_inputs));
 }
 
+std::vector<std::pair<std::string, Eigen::MatrixXd>> GeneratedModel::reduced_parts(const OperatingPoint& op) const {
+  std::vector<std::pair<std::string, Eigen::MatrixXd>> out;
+  if (!k_.reduced_parts || k_.n_reduced_parts == 0) return out;
+  const Eigen::Index n = k_.n_reduced;
+  if (op.y0.size() != size())
+    throw DimensionError("GeneratedModel::reduced_parts: operating point of size " + std::to_string(op.y0.size()) +
+                         " for a model with " + std::to_string(size()) + " coordinates");
+  std::vector<double> C(static_cast<std::size_t>(k_.n_reduced_parts * n * n));
+  check_status(k_.reduced_parts(op.y0.data(), p_.data(), C.data()), "reduced_parts", k_.model);
+  const auto names = name_list(k_.reduced_part_names, k_.n_reduced_parts);
+  for (int i = 0; i < k_.n_reduced_parts; ++i)
+    out.emplace_back(names[static_cast<std::size_t>(i)], Eigen::Map<const Eigen::MatrixXd>(C.data() + i * n * n, n, n));
+  return out;
+}
+
 LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
   if (!k_.linear)
     throw Error("model '" + std::string(k_.model) + "' has nonholonomic constraints: its linear model is first order, "

@@ -331,6 +331,15 @@ int run_matrices(const ModelKernels& k, const Options& o, std::ostream& out, std
       out << ",\n  \"" << name << "\":";
       json_matrix(out, *A);
     }
+    const auto parts = model.reduced_parts(model.operating_point());
+    if (!parts.empty()) {  // the model's names, e.g. the bicycle's M, C1, K0, K2
+      out << ",\n  \"parts\":{";
+      for (std::size_t i = 0; i < parts.size(); ++i) {
+        out << (i ? ",\n    " : "\n    ") << json_string(parts[i].first) << ":";
+        json_matrix(out, parts[i].second);
+      }
+      out << "}";
+    }
     out << "}";
   }
   out << "}\n";

@@ -195,6 +195,16 @@ struct Constraint {
   SourceLocation where;
 };
 
+/// A named part of the reduced second-order form (docs/model-format.md, `reduced_form`): the
+/// coefficient of `monomial` (a product of powers of parameters, or 1) in the reduced matrix
+/// `matrix` (M, Q or K), as the bicycle's Q = v C1 and K = g K0 + v² K2.
+struct NamedCoefficient {
+  std::string name;
+  char matrix = 'M';
+  GiNaC::ex monomial = 1;
+  SourceLocation where;
+};
+
 /// A nonholonomic constraint A(y) ẏ + a(y) = 0 (docs/model-format.md, "nonholonomic"): one
 /// expression in coordinates, rates and parameters, linear in the rates, that the motion keeps at
 /// zero (a velocity that no choice of coordinates removes, such as a skate's sideways speed).
@@ -397,6 +407,10 @@ class Model {
   /// The rates that stay independent speeds with nonholonomic constraints (the rest follow from
   /// the constraints); when not set, chosen by pivoted QR at the operating point (nonholonomic.hpp).
   void set_independent_speeds(std::vector<SceneItem> names) { independent_speeds_ = std::move(names); }
+  /// Named parts of the reduced second-order form (checked by the generator: each reduced matrix
+  /// that has named parts must be their sum).
+  void set_reduced_coefficients(std::vector<NamedCoefficient> c) { reduced_coefficients_ = std::move(c); }
+  const std::vector<NamedCoefficient>& reduced_coefficients() const { return reduced_coefficients_; }
   void set_operating_point(OperatingPoint op) { operating_point_ = std::move(op); }
   /// Adds a scene; its references are checked by validate().
   void add_scene(Scene scene);
@@ -498,6 +512,7 @@ class Model {
   std::vector<SceneItem> independent_;
   std::vector<VelocityConstraint> velocity_constraints_;
   std::vector<SceneItem> independent_speeds_;
+  std::vector<NamedCoefficient> reduced_coefficients_;
   OperatingPoint operating_point_;
   std::vector<Scene> scenes_;
   bool inertial_velocity_terms_ = true;

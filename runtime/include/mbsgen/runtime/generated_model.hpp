@@ -75,6 +75,11 @@ struct ModelKernels {
   const char* const* reduced_coordinate_names = nullptr;
   int (*reduced)(const double* y0, const double* yd0, const double* p, double* M, double* Q, double* K,
                  double* B) = nullptr;
+  /// The model's named parts of the reduced form (`reduced_form` in the model file: the bicycle's
+  /// M, C1, K0, K2), n_reduced×n_reduced each, column-major, one after the other. Trailing.
+  int n_reduced_parts = 0;
+  const char* const* reduced_part_names = nullptr;
+  int (*reduced_parts)(const double* y0, const double* p, double* C) = nullptr;
 };
 
 /// The first n entries of a kernel name array (null entries become "").
@@ -146,6 +151,9 @@ class GeneratedModel {
   /// (outputs: the coordinates). Throws Error when the model has none.
   LinearModel reduced_model(const OperatingPoint& op) const;
   LinearModel reduced_model() const { return reduced_model(operating_point()); }
+  /// The named parts of the reduced form at the operating point, by name (empty when the model
+  /// names none).
+  std::vector<std::pair<std::string, Eigen::MatrixXd>> reduced_parts(const OperatingPoint& op) const;
   /// The outputs z at the operating point (for outputs that depend on ÿ and u: at ÿ = 0 and
   /// u = 0, the static loads); empty when the kernels do not provide `outputs`.
   Eigen::VectorXd outputs(const OperatingPoint& op) const;
