@@ -705,10 +705,14 @@ void check_named_parts(Equations& eq, const LinearEquations& lin, Program::Subst
     std::uint64_t state = 0x51ed2701f3a5c9b3ULL;
     for (int point = 0; point < 2; ++point) {
       const GiNaC::exmap values = detail::sample_point(eq, lin, state, false);
-      const auto r = detail::PointEvaluator(prog, values).evaluate(remainder);
-      const auto x = detail::PointEvaluator(prog, values).evaluate(size);
+      // One evaluation of the remainders and the entries (they share their intermediates).
+      std::vector<ex> entries = remainder;
+      entries.insert(entries.end(), size.begin(), size.end());
+      const auto v = detail::PointEvaluator(prog, values).evaluate(entries);
+      const std::size_t count = remainder.size();
       GiNaC::numeric worst = 0, scale = 0;
-      for (std::size_t k = 0; k < r.size(); ++k) worst = std::max(worst, GiNaC::abs(r[k])), scale = std::max(scale, GiNaC::abs(x[k]));
+      for (std::size_t k = 0; k < count; ++k)
+        worst = std::max(worst, GiNaC::abs(v[k])), scale = std::max(scale, GiNaC::abs(v[count + k]));
       if (worst > scale * GiNaC::numeric(10).power(-30)) {
         GiNaC::Digits = digits;
         std::string list;
