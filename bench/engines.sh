@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Per-call speed against numeric engines (issue 17 §2): builds and runs bench/engines_bench.cpp,
+# our mass_matrix and residual kernels against MuJoCo and Orocos KDL on the spatial chains
+# (N = 3, 6, 12, 30) and the PUMA 560, after checking that all three agree to 1e-12. Called by
+# scripts/bench.sh (which installs libmujoco-dev and liborocos-kdl-dev); bench/report_engines.py
+# turns the results into a section of docs/accuracy-vs-time.md.
+#
+#   bench/engines.sh [--quick] [--jobs N] [--build DIR] [--out DIR]
+#
+#   --build DIR  a build directory configured with -DMBSGEN_BUILD_BENCH=ON (default build/bench;
+#                configured here in Release when it has no CMakeCache.txt)
+#   --out DIR    results: engines.csv, engines_agreement.csv, engines_mjcf/, engines.log
+#                (default DIR/results of the build directory); versions appended to system.txt
+# Exit status 1 when the engines disagree or are missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+quick=()
+jobs=1
+build=build/bench
+out=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --quick) quick=(--quick) ;;
+    --jobs) jobs="$2"; shift ;;
+    --build) build="$2"; shift ;;
+    --out) out="$2"; shift ;;
+    *) echo "usage: bench/engines.sh [--quick] [--jobs N] [--build DIR] [--out DIR]" >&2; exit 2 ;;
+  esac
+  shift
+done
+out=${out:-$build/results}
+start=$(date +%s)
+log() { printf '[engines %4ds] %s\n' $(( $(date +%s) - start )) "$*" >&2; }
+
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  log "configuring $build (Release, benchmarks on, tests off)"
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DMBSGEN_BUILD_BENCH=ON -DMBSGEN_BUILD_TESTS=OFF >/dev/null
+fi
+log "building engines_bench (-j $jobs; the 30-link chain's kernels take minutes to compile)"
+if ! cmake --build "$build" --target engines_bench -j "$jobs" >"$build/engines_build.log" 2>&1; then
+  if grep -q "No rule to make target .engines_bench\|unknown target .engines_bench" "$build/engines_build.log"; then
+    echo "engines: engines_bench was not configured (MuJoCo or KDL missing: apt-get install libmujoco-dev liborocos-kdl-dev)" >&2
+  else
+    tail -20 "$build/engines_build.log" >&2
+  fi
+  exit 1
+fi
+mkdir -p "$out"
+ver() { dpkg-query -W -f='${Version}' "$1" 2>/dev/null || echo "?"; }
+{
+  echo "mujoco: $(ver libmujoco-dev)"
+  echo "orocos_kdl: $(ver liborocos-kdl-dev)"
+} >>"$out/system.txt"
+log "MuJoCo and KDL against our kernels ${quick[*]:-}"
+"$build/bench/engines_bench" "$out" "${quick[@]}" 2>"$out/engines.log" || {
+  tail -30 "$out/engines.log" >&2
+  exit 1
+}
+log "done"
