@@ -15,6 +15,8 @@ import os
 import subprocess
 import sys
 
+from report_engines import engines_section  # issue 17 §2: MuJoCo and KDL (bench/engines.sh)
+
 RESULTS, OUTPUT, IMAGES = sys.argv[1], sys.argv[2], sys.argv[3]
 F_REPORT = 100  # frequencies per sweep in frf_accuracy (kF)
 BAR = 1e-10     # the runtime tests' accuracy bar for well-conditioned points
@@ -631,6 +633,8 @@ if series["t"]:
     body += "unset multiplot"
     w(gnuplot("generation", body, size=(960, 720)))
     w("")
+
+w(engines_section(RESULTS))
 
 # ---- 5. conclusions ----
 w("## 5. Which method")

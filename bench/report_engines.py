@@ -94,7 +94,8 @@ def engines_section(results):
         "`mj_kinematics` + `mj_comPos` + `mj_comVel` + `mj_rne` (`qfrc_bias`), KDL `JntToCoriolis` + "
         "`JntToGravity` or one `ChainIdSolver_RNE` pass with q̈ = 0 (the faster is shown, *RNE* when it is "
         "that one); **M+bias** both, MuJoCo sharing its position stages. Medians of %s interleaved repetitions "
-        "over 16 random states (`bench/engines_bench.cpp`). Before timing, the three must agree to 1e-12 "
+        "(batches of about 2 ms cycling through 16 random states, in thread CPU time so that other jobs on the "
+        "shared machine count little; `bench/engines_bench.cpp`). Before timing, the three must agree to 1e-12 "
         "(largest difference over largest entry, over the states; *agreement* is the worst pair). "
         "*ratio* = fastest engine / ours: above 1 we are faster."
         % (system.get("mujoco", "?"), system.get("orocos_kdl", "?"), rows[0].get("repetitions", "?")),

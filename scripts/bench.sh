@@ -36,7 +36,7 @@ log() { printf '[bench %4ds] %s\n' $(( $(date +%s) - start )) "$*" >&2; }
 
 # ---- dependencies -------------------------------------------------------------------------------
 scripts/deps.sh
-extra=(python3-sympy octave octave-control libbenchmark-dev gnuplot-nox)
+extra=(python3-sympy octave octave-control libbenchmark-dev gnuplot-nox libmujoco-dev liborocos-kdl-dev)
 missing=()
 for p in "${extra[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -137,6 +137,7 @@ for d in "$out"/modes_data/*/; do
   timeout "$oct_limit" octave --no-gui -q bench/peers/octave_modes.m "$d" "$name" >>"$out/octave_modes.csv" 2>/dev/null ||
     echo "octave,$name,,,timeout,nan,nan" >>"$out/octave_modes.csv"
 done
+bench/engines.sh --build "$build" --out "$out" --jobs "$jobs" "${q[@]}" || log "engines: failed (see $out/engines.log)"
 echo "load_end: $(cut -d' ' -f1-3 /proc/loadavg)" >>"$out/system.txt"
 echo "duration_s: $(( $(date +%s) - start ))" >>"$out/system.txt"
 
