@@ -1,4 +1,5 @@
-# mbsgen_add_model(<target> MODEL <file> [SCENE <name>] [SOLVER] [OUTPUT_DIR <dir>] [ID <id>])
+# mbsgen_add_model(<target> MODEL <file> [SCENE <name>] [SOLVER] [OUTPUT_DIR <dir>] [ID <id>]
+#                  [PARTS <n>])
 #
 # Generates a model's kernels at build time and compiles them into the static library <target>,
 # linked to mbsgen::runtime, with the typed C++ API <id>_model.hpp (namespace <id>: Parameters
@@ -13,12 +14,15 @@
 #               present there are compiled as they are, and MODEL may be omitted.
 #   ID          C identifier prefix of the kernels and namespace of the API (default: <target>
 #               with every character that is not a letter, digit or _ replaced by _)
+#   PARTS       for large models (tens of thousands of operations per kernel): the long kernels'
+#               parts go to <n> files <id>_part1.cpp … that the build compiles in parallel, at
+#               -O1 (as fast for straight-line arithmetic, half the compile time); default 0
 #
 # Documented in docs/cmake.md.
 include_guard(GLOBAL)
 
 function(mbsgen_add_model target)
-  cmake_parse_arguments(PARSE_ARGV 1 ARG "SOLVER" "MODEL;SCENE;OUTPUT_DIR;ID" "")
+  cmake_parse_arguments(PARSE_ARGV 1 ARG "SOLVER" "MODEL;SCENE;OUTPUT_DIR;ID;PARTS" "")
   if(ARG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "mbsgen_add_model(${target}): unknown arguments: ${ARG_UNPARSED_ARGUMENTS}")
   endif()
@@ -28,11 +32,24 @@ function(mbsgen_add_model target)
   if(NOT ARG_ID)
     string(MAKE_C_IDENTIFIER "${target}" ARG_ID)
   endif()
+  if(NOT ARG_PARTS)
+    set(ARG_PARTS 0)
+  endif()
+  if(NOT ARG_PARTS MATCHES "^[0-9]+$" OR ARG_PARTS GREATER 64)
+    message(FATAL_ERROR "mbsgen_add_model(${target}): PARTS must be a number from 0 to 64, not '${ARG_PARTS}'")
+  endif()
   if(NOT ARG_OUTPUT_DIR)
     set(ARG_OUTPUT_DIR ${CMAKE_CURRENT_BINARY_DIR}/mbsgen/${target})
   endif()
   get_filename_component(_dir "${ARG_OUTPUT_DIR}" ABSOLUTE BASE_DIR ${CMAKE_CURRENT_BINARY_DIR})
   set(_sources ${_dir}/${ARG_ID}.cpp ${_dir}/${ARG_ID}_model.cpp)
+  set(_parts "")
+  if(ARG_PARTS GREATER 0)
+    foreach(_k RANGE 1 ${ARG_PARTS})
+      list(APPEND _parts ${_dir}/${ARG_ID}_part${_k}.cpp)
+    endforeach()
+    list(APPEND _sources ${_parts})
+  endif()
   set(_files ${_sources} ${_dir}/${ARG_ID}.hpp ${_dir}/${ARG_ID}_model.hpp ${_dir}/${ARG_ID}.json)
 
   if(TARGET mbsgen::mbsgen)
@@ -49,7 +66,8 @@ function(mbsgen_add_model target)
     add_custom_command(
       OUTPUT ${_stamp}
       BYPRODUCTS ${_files}
-      COMMAND mbsgen::mbsgen generate ${_model} --scene ${ARG_SCENE} --id ${ARG_ID} --out ${_dir}
+      COMMAND mbsgen::mbsgen generate ${_model} --scene ${ARG_SCENE} --id ${ARG_ID} --parts ${ARG_PARTS}
+              --out ${_dir}
       COMMAND ${CMAKE_COMMAND} -E touch ${_stamp}
       DEPENDS ${_model} mbsgen::mbsgen
       COMMENT "mbsgen: generating ${ARG_ID} from ${ARG_MODEL} (scene ${ARG_SCENE})"
@@ -70,6 +88,10 @@ function(mbsgen_add_model target)
   target_compile_features(${target} PUBLIC cxx_std_17)
   # Generated code is plain arithmetic: optimise it even in debug builds of the consumer.
   target_compile_options(${target} PRIVATE $<$<CXX_COMPILER_ID:GNU,Clang>:-O2>)
+  if(_parts)
+    set_source_files_properties(${_parts} PROPERTIES
+                                COMPILE_OPTIONS $<$<CXX_COMPILER_ID:GNU,Clang>:-O1>)
+  endif()
   set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
   if(ARG_SOLVER)

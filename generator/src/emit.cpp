@@ -7,6 +7,8 @@
 #include "mbsgen/generator/escape.hpp"
 #include "mbsgen/generator/output_files.hpp"
 
+#include "emit_chunks.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -242,6 +244,11 @@ struct Kernel {
   bool wrapped = false;
   /// Emitted as a static function (not declared in the header).
   bool internal = false;
+  /// Code that computes the outputs instead of their expressions (whose values are then only
+  /// placeholders giving the sizes), setting `int computed_status` (a status > 1 is returned as
+  /// it is); run before the zeros at the operating point. linear_structured: from `linear`.
+  std::string computed_by = {};
+  std::size_t computed_by_operations = 0;
 };
 
 std::vector<ex> column_major(const ExMatrix& A, std::size_t rows, std::size_t cols) {
@@ -257,6 +264,8 @@ std::string json_string(const std::string& s) { return json_string_literal(s); }
 struct EmittedKernel {
   std::string code;
   KernelInfo info;
+  /// The kernel's body cut into functions (emit_chunks.hpp): empty definitions when it is short.
+  detail::ChunkedBody chunks;
 };
 
 // Sets the entries that are exact zeros at the operating point when the kernel is called
@@ -276,8 +285,9 @@ std::string zeros_at_operating_point(const Kernel& k) {
   return code.str();
 }
 
-EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog, bool cse) {
-  // Intermediates reachable from the outputs, in definition order.
+// The statements of a kernel: the intermediates its outputs need (in definition order), the
+// outputs, and the operating point's values for its test (`const double op<i>`); then CSE.
+std::vector<Statement> kernel_statements(const Kernel& k, Program& prog, bool cse) {
   std::vector<char> needed(prog.definitions().size(), 0);
   std::vector<ex> stack;
   for (const auto& b : k.outputs)
@@ -302,60 +312,167 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
       const auto& d = prog.definitions()[i];
       statements.push_back({d.symbol.get_name(), d.value, true, d.symbol});
     }
-  for (const auto& b : k.outputs)
-    for (std::size_t i = 0; i < b.values.size(); ++i)
-      statements.push_back({b.name + "[" + std::to_string(i) + "]", b.values[i], false, GiNaC::ex()});
+  if (k.computed_by.empty())  // otherwise the outputs come from computed_by
+    for (const auto& b : k.outputs)
+      for (std::size_t i = 0; i < b.values.size(); ++i)
+        statements.push_back({b.name + "[" + std::to_string(i) + "]", b.values[i], false, GiNaC::ex()});
   for (std::size_t i = 0; i < k.at_op.values.size(); ++i)
     statements.push_back({"const double op" + std::to_string(i), k.at_op.values[i], false, GiNaC::ex()});
   if (cse) statements = eliminate_common_subexpressions(statements, prog.order());
+  return statements;
+}
 
-  CppPrinter printer(prog.order());
+// The statements as C++, each with its operation count and the local it defines.
+std::vector<detail::PrintedStatement> print_statements(const Kernel& k, const std::vector<Statement>& statements,
+                                                       CanonicalOrder& order, std::size_t& operations) {
+  CppPrinter printer(order);
   for (const auto& a : k.inputs)
     for (std::size_t i = 0; i < a.symbols.size(); ++i)
       printer.names[a.symbols[i]] = a.name + "[" + std::to_string(i) + "]";
-  std::ostringstream body;
+  std::vector<detail::PrintedStatement> out;
+  out.reserve(statements.size());
   for (const auto& s : statements) {
+    const std::size_t before = printer.operations;
     bool negative = false;
     std::string rhs = printer.term(s.value, negative);
     // A temporary holds its canonical value (the sign its symbol carries); an output its value.
-    if (s.temporary && prog.order().sign(s.symbol) < 0) negative = !negative;
+    if (s.temporary && order.sign(s.symbol) < 0) negative = !negative;
     if (negative) {
       ++printer.operations;
       rhs = is_a<GiNaC::add>(s.value) ? "-(" + rhs + ")" : "-" + rhs;
     }
+    detail::PrintedStatement p{"", printer.operations - before, "", {}};
     if (s.temporary) {
-      body << "  const double " << s.target << " = " << rhs << ";\n";
+      p.code = "  const double " + s.target + " = " + rhs + ";\n";
+      p.defines = s.target;
       printer.names[s.symbol] = s.target;
     } else {
-      body << "  " << s.target << " = " << rhs << ";\n";
+      p.code = "  " + s.target + " = " + rhs + ";\n";
+      if (s.target.rfind("const double ", 0) == 0) {  // an operating point value, read after the body
+        p.defines = s.target.substr(13);
+        p.needed_after = true;
+      }
     }
+    out.push_back(std::move(p));
   }
+  operations = printer.operations;
+  return out;
+}
 
-  std::ostringstream sig;
-  sig << "int " << id << "_" << k.name << (k.wrapped ? "_full" : "") << "(";
-  bool first = true;
+// Which earlier statements each statement reads (for chunk_body).
+void find_reads(const std::vector<Statement>& statements, std::vector<detail::PrintedStatement>& printed) {
+  std::unordered_map<ex, std::size_t, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> defined;
+  for (std::size_t j = 0; j < statements.size(); ++j) {
+    std::vector<ex> stack{statements[j].value};
+    while (!stack.empty()) {
+      const ex e = stack.back();
+      stack.pop_back();
+      if (is_a<GiNaC::symbol>(e)) {
+        if (auto it = defined.find(e); it != defined.end()) printed[j].reads.push_back(it->second);
+        continue;
+      }
+      for (std::size_t i = 0; i < e.nops(); ++i) stack.push_back(e.op(i));
+    }
+    if (statements[j].temporary) defined.emplace(statements[j].symbol, j);
+  }
+}
+
+EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog, bool cse, std::size_t chunk_operations) {
+  const std::vector<Statement> statements = kernel_statements(k, prog, cse);
+  std::size_t operations = 0;
+  std::vector<detail::PrintedStatement> printed = print_statements(k, statements, prog.order(), operations);
+
+  const std::string fn = id + "_" + k.name + (k.wrapped ? "_full" : "");
+  std::string parameters, arguments;
   for (const auto& a : k.inputs) {
-    sig << (first ? "" : ", ") << "const double* " << a.name;
-    first = false;
+    parameters += (parameters.empty() ? "" : ", ") + std::string("const double* ") + a.name;
+    arguments += (arguments.empty() ? "" : ", ") + a.name;
   }
   for (const auto& b : k.outputs) {
-    sig << (first ? "" : ", ") << "double* " << b.name;
-    first = false;
+    parameters += (parameters.empty() ? "" : ", ") + std::string("double* ") + b.name;
+    arguments += (arguments.empty() ? "" : ", ") + b.name;
   }
-  sig << ")";
+  const std::string sig = "int " + fn + "(" + parameters + ")";
+
+  EmittedKernel out;
+  std::string body;
+  if (chunk_operations > 0 && operations > chunk_operations && k.computed_by.empty()) {
+    find_reads(statements, printed);
+    out.chunks = detail::chunk_body(id + "_kernel_parts::", k.name, parameters, arguments, printed, chunk_operations);
+    body = out.chunks.calls;
+  } else {
+    for (const auto& p : printed) body += p.code;
+  }
+  if (!k.computed_by.empty()) {
+    body += k.computed_by;
+    operations += k.computed_by_operations;
+  }
 
   std::ostringstream code;
-  code << "// " << k.doc << "\n// operations: " << printer.operations << "\n";
-  code << (k.wrapped || k.internal ? "static " : "extern \"C\" ") << sig.str() << " {\n";
+  code << "// " << k.doc << "\n// operations: " << operations << "\n";
+  code << (k.wrapped || k.internal ? "static " : "extern \"C\" ") << sig << " {\n";
   for (const auto& a : k.inputs) code << "  (void)" << a.name << ";\n";
-  code << body.str() << zeros_at_operating_point(k);
+  code << body << zeros_at_operating_point(k);
   code << "  int status = 0;\n";
+  if (!k.computed_by.empty()) code << "  if (computed_status > 1) return computed_status;\n";
   for (const auto& b : k.outputs)
     if (!b.values.empty())
       code << "  if (!all_finite(" << b.name << ", " << b.values.size() << ")) status = 1;\n";
   code << "  return status;\n}\n\n";
-  return {code.str(), {k.name, sig.str(), printer.operations}};
+  out.code = code.str();
+  out.info = {k.name, sig, operations};
+  return out;
 }
+
+// linear_structured from linear (issue 17 §1: one derivation compiled once, not two): Q into
+// D's buffer and K into Ks's, split in place by split_symmetric. Entries zero for every
+// parameter value (lin's exact zeros) are set to 0; those zero at the operating point are set by
+// the kernel's test as in every linear kernel. (X + Xᵀ)/2 computed numerically is exactly
+// symmetric, which the symbolic entries evaluated one by one were only to rounding.
+std::string structured_from_linear(const std::string& id, const Kernel& k, const LinearEquations& lin,
+                                   std::size_t& operations) {
+  const std::size_t f = lin.M.size(), m = lin.B.empty() ? 0 : lin.B[0].size(), r = lin.Cy.size();
+  auto pattern = [&](const ExMatrix& A) {
+    std::string s;
+    for (std::size_t j = 0; j < f; ++j)
+      for (std::size_t i = 0; i < f; ++i) s += A[i][j].is_zero() ? '0' : 'x';
+    return s;
+  };
+  auto count = [&](const std::string& sym, const std::string& skew) {
+    std::size_t n = 0;
+    for (std::size_t j = 0; j < f; ++j)
+      for (std::size_t i = 0; i < j; ++i) n += (sym[i + f * j] != '0') * 2 + (skew[i + f * j] != '0') * 3;
+    return n;
+  };
+  const std::string D = pattern(lin.D), G = pattern(lin.G), Ks = pattern(lin.Ks), N = pattern(lin.N);
+  operations = count(D, G) + count(Ks, N);
+  std::ostringstream c;
+  c << "  double B_linear[" << std::max<std::size_t>(f * m, 1) << "], Cy_linear[" << std::max<std::size_t>(r * f, 1)
+    << "], Cv_linear[" << std::max<std::size_t>(r * f, 1) << "];\n";
+  c << "  const int computed_status = " << id << "_linear" << (k.wrapped ? "_full" : "")
+    << "(y0, yd0, p, M, D, Ks, B_linear, Cy_linear, Cv_linear);\n";
+  c << "  split_symmetric(D, G, " << f << ", \"" << D << "\", \"" << G << "\");\n";
+  c << "  split_symmetric(Ks, N, " << f << ", \"" << Ks << "\", \"" << N << "\");\n";
+  return c.str();
+}
+
+// The generated file's helper for structured_from_linear.
+const char* const kSplitSymmetric = R"(// Splits X (n×n, column-major) in place into its symmetric part (X + Xᵀ)/2, left in X, and its
+// skew part (X − Xᵀ)/2 in A; an entry marked '0' in sym or skew (column-major) is an exact zero.
+void split_symmetric(double* X, double* A, int n, const char* sym, const char* skew) {
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < j; ++i) {
+      const int ij = i + n * j, ji = j + n * i;
+      const double x = X[ij], y = X[ji];
+      X[ij] = X[ji] = sym[ij] == '0' ? 0.0 : 0.5 * (x + y);
+      A[ij] = skew[ij] == '0' ? 0.0 : 0.5 * (x - y);
+      A[ji] = skew[ij] == '0' ? 0.0 : 0.5 * (y - x);
+    }
+    if (sym[j + n * j] == '0') X[j + n * j] = 0.0;
+    A[j + n * j] = 0.0;
+  }
+}
+)";
 
 // The kernels of a model with closed loops (loop_closure.hpp), in all the tree's coordinates:
 // Φ(y), its Jacobian Φ_y (m×n) and the acceleration term γ(y, ẏ) of Φ_y ÿ + γ = 0, and the
@@ -738,15 +855,19 @@ void second_order_kernels(Equations& eq, const LinearEquations& lin, const std::
                       {"B", column_major(lin.B, f, m), ""},
                       {"Cy", column_major(lin.Cy, r, f), ""},
                       {"Cv", column_major(lin.Cv, r, f), ""}}});
-  kernels.push_back({"linear_structured",
-                     "M, damping D = sym Q, gyroscopic G = skew Q, stiffness sym K, circulatory "
-                     "N = skew K at (y0, yd0), column-major",
-                     {{"y0", y}, {"yd0", lin.at_rest ? none : yd}, {"p", p}},
-                     {{"M", column_major(lin.M, f, f), ""},
-                      {"D", column_major(lin.D, f, f), ""},
-                      {"G", column_major(lin.G, f, f), ""},
-                      {"Ks", column_major(lin.Ks, f, f), ""},
-                      {"N", column_major(lin.N, f, f), ""}}});
+  // linear_structured splits linear's Q and K (structured_from_linear): its outputs' values are
+  // placeholders of the right sizes.
+  Kernel structured{"linear_structured",
+                    "M, damping D = sym Q, gyroscopic G = skew Q, stiffness sym K, circulatory "
+                    "N = skew K at (y0, yd0), column-major",
+                    {{"y0", y}, {"yd0", lin.at_rest ? none : yd}, {"p", p}},
+                    {{"M", std::vector<ex>(f * f, 0), ""},
+                     {"D", std::vector<ex>(f * f, 0), ""},
+                     {"G", std::vector<ex>(f * f, 0), ""},
+                     {"Ks", std::vector<ex>(f * f, 0), ""},
+                     {"N", std::vector<ex>(f * f, 0), ""}}};
+  structured.computed_by = "linear";  // replaced by the code in emit(), which knows the id
+  kernels.push_back(structured);
   mark_zeros_at_operating_point(kernels[kernels.size() - 2], {&lin.zeros.M, &lin.zeros.Q, &lin.zeros.K,
                                 &lin.zeros.B, &lin.zeros.Cy, &lin.zeros.Cv}, eq, lin);
   mark_zeros_at_operating_point(kernels.back(), {&lin.zeros.M, &lin.zeros.D, &lin.zeros.G,
@@ -874,6 +995,40 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
   return kernels;
 }
 
+// The kernels' parts (emit_chunks.hpp): in the main file when parts is 0, otherwise spread
+// over `parts` files, the next part to the file with the fewest operations so far, so that the
+// files take about the same time to compile in parallel.
+void distribute_chunks(GeneratedCode& out, const std::vector<std::pair<std::string, std::size_t>>& chunks,
+                       std::size_t parts, const std::string& banner, std::ostringstream& main_file) {
+  const std::string open = "namespace " + out.id + "_kernel_parts {\n\n", close = "}  // namespace " + out.id + "_kernel_parts\n";
+  if (parts == 0) {
+    if (chunks.empty()) return;
+    main_file << open;
+    for (const auto& [code, ops] : chunks) main_file << code << "\n";
+    main_file << close;
+    return;
+  }
+  std::vector<std::string> files(parts);
+  std::vector<std::size_t> load(parts, 0);
+  for (const auto& [code, ops] : chunks) {
+    const std::size_t k = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    files[k] += code + "\n";
+    load[k] += ops;
+  }
+  out.parts.clear();
+  for (std::size_t k = 0; k < parts; ++k) {
+    std::ostringstream f;
+    f << banner << "// Part " << k + 1 << " of " << parts << " of the kernels of " << out.id << ".cpp: " << load[k]
+      << " operations.\n";
+    if (files[k].empty()) {
+      f << "// Nothing here: the kernels are short enough to stay in " << out.id << ".cpp.\n";
+    } else {
+      f << "#include <cmath>\n\n" << open << files[k] << close;
+    }
+    out.parts.push_back(f.str());
+  }
+}
+
 GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin,
                    const EmitOptions& options) {
   GeneratedCode out;
@@ -893,24 +1048,39 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   const std::size_t n = eq.y.size();
   std::vector<Kernel> kernels = model_kernels(model, eq, lin);
   std::ostringstream kernel_code;
+  std::vector<std::pair<std::string, std::size_t>> chunks;  // definitions of kernel parts, operations
   if (loops) {
     kernel_code << "namespace {\n" << kLuSolve << "}  // namespace\n\n";
     for (Kernel& k : loop_kernels(eq, lin)) {
-      EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse);
+      EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse, options.chunk_operations);
       kernel_code << ek.code;
       if (!k.internal) out.kernels.push_back(ek.info);
     }
     kernel_code << assemble_code(out.id, eq);
     out.kernels.push_back({"assemble", "int " + out.id + "_assemble(const double* yi, const double* p, double* y)", 0});
   }
-  for (const auto& k : kernels) {
-    const std::string as = k.name == "outputs_general"                          ? "outputs"
-                           : k.name == "output_terms" || k.name == "descriptor" || k.name == "reduced" ||
-                                     k.name == "reduced_parts"
+  bool split_needed = false;
+  for (const auto& k0 : kernels) {
+    const std::string as = k0.name == "outputs_general"                          ? "outputs"
+                           : k0.name == "output_terms" || k0.name == "descriptor" || k0.name == "reduced" ||
+                                     k0.name == "reduced_parts"
                                ? "linear"
-                                                                                : k.name;
+                                                                                : k0.name;
     if (!scene.emits(as)) continue;
-    EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse);
+    Kernel k = k0;
+    if (k.computed_by == "linear") {
+      if (!scene.emits("linear"))
+        throw std::logic_error("mbsgen::emit: linear_structured needs the linear kernel, which the scene prunes");
+      k.computed_by = structured_from_linear(out.id, k, lin, k.computed_by_operations);
+      k.computed_by_operations += out.kernels.back().operations;  // linear's, emitted just before
+      split_needed = true;
+    }
+    EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse, options.chunk_operations);
+    if (!ek.chunks.definitions.empty()) {
+      kernel_code << "namespace " << out.id << "_kernel_parts {\n" << ek.chunks.declarations << "}\n\n";
+      for (std::size_t c = 0; c < ek.chunks.definitions.size(); ++c)
+        chunks.push_back({ek.chunks.definitions[c], ek.chunks.operations[c]});
+    }
     kernel_code << ek.code;
     if (k.wrapped) {
       const std::string full = "_" + k.name + "_full(";
@@ -960,6 +1130,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   c << "// Whether a kernel argument is the operating point's value (to 8 units in the last place).\n"
        "inline bool at_operating_point(double argument, double value) {\n"
        "  return argument == value || std::fabs(argument - value) <= 8 * 2.220446049250313e-16 * std::fabs(value);\n}\n";
+  if (split_needed) c << kSplitSymmetric;
   c << "}  // namespace\n\n";
   c << "extern \"C\" int " << out.id << "_abi_version(void) { return " << kAbiVersion << "; }\n";
   c << names_array("coordinate_names", cn) << names_array("parameter_names", pn)
@@ -980,6 +1151,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   for (const auto& q : model.parameters()) c << format_double(q.value) << ", ";
   c << "0.0};\n\n";
   c << kernel_code.str();
+  distribute_chunks(out, chunks, options.parts, banner, c);
   out.source = c.str();
 
   out.manifest = manifest_json(model, eq, lin, scene, out);
@@ -992,9 +1164,12 @@ void write_atomically(const std::filesystem::path& path, const std::string& cont
 
 std::vector<OutputFile> generated_files(const GeneratedCode& code, const std::string& dir) {
   const std::filesystem::path d(dir);
-  return {{d / (code.id + ".hpp"), code.header},
-          {d / (code.id + ".cpp"), code.source},
-          {d / (code.id + ".json"), code.manifest}};
+  std::vector<OutputFile> files = {{d / (code.id + ".hpp"), code.header},
+                                    {d / (code.id + ".cpp"), code.source},
+                                    {d / (code.id + ".json"), code.manifest}};
+  for (std::size_t k = 0; k < code.parts.size(); ++k)
+    files.push_back({d / (code.id + "_part" + std::to_string(k + 1) + ".cpp"), code.parts[k]});
+  return files;
 }
 
 void write_generated(const GeneratedCode& code, const std::string& dir) {

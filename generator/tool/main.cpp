@@ -141,6 +141,8 @@ int main(int argc, char** argv) try {
   app.set_version_flag("--version", std::string("mbsgen ") + mbsgen::kGeneratorVersion, "print the version and exit");
   std::string model_file, out_dir, scene = "full", id;
   bool no_cse = false;
+  std::size_t parts = 0;
+  std::size_t part_operations = 2500;
   auto* check = app.add_subcommand("check", "read and validate a model file (and its operating point)");
   check->add_option("MODEL", model_file, "model file (YAML)")->required();
   auto* info = app.add_subcommand("info", "scenes, effects, kernels and operation counts");
@@ -153,6 +155,12 @@ int main(int argc, char** argv) try {
   generate->add_option("--id", id, "C identifier prefix of the kernels (default: the model name, "
                                    "MODEL_SCENE for a scene)");
   generate->add_flag("--no-cse", no_cse, "skip common-subexpression elimination");
+  generate->add_option("--parts", parts,
+                       "also write ID_part1.cpp … ID_partN.cpp holding the long kernels' parts, to compile in "
+                       "parallel (default 0: all in ID.cpp)")
+      ->check(CLI::Range(0, 64));
+  generate->add_option("--part-operations", part_operations,
+                       "operations per part of a long kernel (default 2500; 0: no kernel is cut, as before issue 17)");
   app.add_subcommand("linear", "modes and frequency responses of raw matrices (mbsgen linear --help)");
   app.add_subcommand("run", "generate, compile, cache and run a model's solver (mbsgen run --help)");
   try {
@@ -188,6 +196,8 @@ int main(int argc, char** argv) try {
     }
     mbsgen::EmitOptions options;
     options.cse = !no_cse;
+    options.parts = parts;
+    options.chunk_operations = part_operations;
     options.source_file = model_file;
     options.id = id;
     mbsgen::GeneratedCode code = mbsgen::emit(pruned, eq, lin, options);
@@ -200,7 +210,8 @@ int main(int argc, char** argv) try {
                                              range ? range->to_hz : 0.0, range ? range->points : 0,
                                              range ? !range->logarithmic : false),
                             out_dir);
-    std::cerr << "mbsgen: wrote " << out_dir << "/" << code.id << "{.hpp,.cpp,.json,_model.hpp,_model.cpp} in " << seconds
+    std::cerr << "mbsgen: wrote " << out_dir << "/" << code.id << "{.hpp,.cpp,.json,_model.hpp,_model.cpp}"
+              << (code.parts.empty() ? "" : " and " + std::to_string(code.parts.size()) + " part files") << " in " << seconds
               << " s\n";
     return 0;
   } catch (const mbsgen::ModelError& e) {

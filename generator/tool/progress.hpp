@@ -1,4 +1,4 @@
-// Progress of a long `mbsgen check`, `info` or `generate` on a terminal (issue 14 §4): after
+// Progress of a long `mbsgen check`, `info`, `generate` or `run` on a terminal (issues 14 §4, 17 §1): after
 // kQuietSeconds, one line on stderr names the stage and the elapsed time, rewritten in place
 // twice a second and erased at the end. Nothing is written when stderr is not a terminal
 // (pipes, files, ctest), so that captured output and messages stay as they are.
@@ -20,7 +20,7 @@ class Progress {
  public:
   static constexpr double kQuietSeconds = 2.0;  ///< shorter runs print nothing
 
-  /// `command`: "check", "info" or "generate", shown in the line.
+  /// `command`: "check", "info", "generate" or "run", shown in the line.
   explicit Progress(std::string command) : command_(std::move(command)) {
     if (isatty(STDERR_FILENO) == 1) thread_ = std::thread([this] { run(); });
   }
@@ -29,7 +29,16 @@ class Progress {
   Progress& operator=(const Progress&) = delete;
 
   /// The stage now running (a string literal: only its address is kept).
-  void stage(const char* name) { stage_.store(name); }
+  void stage(const char* name) {
+    stage_.store(name);
+    detail(std::string());
+  }
+
+  /// Shown after the stage, e.g. "3 of 5 files" while compiling.
+  void detail(std::string text) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    detail_ = std::move(text);
+  }
 
   /// Stops the thread and erases the line; call before writing anything else to stderr.
   void stop() {
@@ -50,7 +59,8 @@ class Progress {
     while (!wake_.wait_for(lock, std::chrono::milliseconds(500), [this] { return done_; })) {
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (s < kQuietSeconds) continue;
-      std::fprintf(stderr, "\r\033[Kmbsgen %s: %s (%.0f s)", command_.c_str(), stage_.load(), s);
+      std::fprintf(stderr, "\r\033[Kmbsgen %s: %s%s%s (%.0f s)", command_.c_str(), stage_.load(),
+                   detail_.empty() ? "" : ": ", detail_.c_str(), s);
       std::fflush(stderr);
       shown = true;
     }
@@ -63,6 +73,7 @@ class Progress {
   std::string command_;
   std::atomic<const char*> stage_{"reading the model"};
   std::mutex mutex_;
+  std::string detail_;  // guarded by mutex_
   std::condition_variable wake_;
   bool done_ = false;
   std::thread thread_;

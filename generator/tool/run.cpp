@@ -5,6 +5,8 @@
 // the runtime) rebuilds it. Nothing is written outside the cache.
 #include "run.hpp"
 
+#include "progress.hpp"
+
 #include "mbsgen/generator/check.hpp"
 #include "mbsgen/generator/emit.hpp"
 #include "mbsgen/generator/emit_api.hpp"
@@ -19,6 +21,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -26,9 +29,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 #include <system_error>
+#include <thread>
 
 extern char** environ;
 
@@ -110,9 +115,9 @@ Toolchain toolchain() {
   return t;
 }
 
-// Runs argv[0] (searched on PATH when it has no '/') with argv, its standard output and error
-// going to log; returns its exit status, or -1 when it could not run or was killed.
-int run_program(const std::vector<std::string>& args, const fs::path& log) {
+// Starts argv[0] (searched on PATH when it has no '/') with argv, its standard output and error
+// going to log (created exclusively); returns its process id.
+pid_t spawn_program(const std::vector<std::string>& args, const fs::path& log) {
   const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) throw std::runtime_error("cannot create " + log.string() + ": " + std::strerror(errno));
   posix_spawn_file_actions_t actions;
@@ -127,10 +132,47 @@ int run_program(const std::vector<std::string>& args, const fs::path& log) {
   posix_spawn_file_actions_destroy(&actions);
   ::close(fd);
   if (error != 0) throw std::runtime_error("cannot run " + args[0] + ": " + std::strerror(error));
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return pid;
+}
+
+// The exit status of a process that ended with status; -1 when it was killed.
+int exit_status(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
+
+// One compiler run and where its messages go.
+struct Job {
+  std::vector<std::string> args;
+  fs::path log;
+};
+
+// Runs the jobs, at most `parallel` at a time, in order, reporting "k of n files" to progress.
+// Returns the jobs that failed (after every started one has ended; none is started after a
+// failure).
+std::vector<std::size_t> run_jobs(const std::vector<Job>& jobs, std::size_t parallel, Progress& progress) {
+  std::vector<std::pair<pid_t, std::size_t>> running;
+  std::vector<std::size_t> failed;
+  std::size_t next = 0, done = 0;
+  auto report = [&] { progress.detail(std::to_string(done) + " of " + std::to_string(jobs.size()) + " files"); };
+  report();
+  while (next < jobs.size() || !running.empty()) {
+    while (failed.empty() && next < jobs.size() && running.size() < parallel) {
+      running.push_back({spawn_program(jobs[next].args, jobs[next].log), next});
+      ++next;
+    }
+    if (running.empty()) break;
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, 0);
+    if (pid < 0) {
+      if (errno == EINTR) continue;
+      throw std::runtime_error(std::string("waiting for the compiler: ") + std::strerror(errno));
+    }
+    const auto it = std::find_if(running.begin(), running.end(), [&](const auto& r) { return r.first == pid; });
+    if (it == running.end()) continue;  // not one of ours
+    if (exit_status(status) != 0) failed.push_back(it->second);
+    running.erase(it);
+    ++done;
+    report();
+  }
+  return failed;
 }
 
 // The record written after a solver, last of a cache entry: its size and FNV-1a hash. It guards
@@ -165,20 +207,91 @@ bool sound_entry(const fs::path& dir, std::string& why) {
   return why.empty();
 }
 
+// How many compilers run at once: MBSGEN_JOBS when set (1 to 64), else the number of cores.
+std::size_t parallel_jobs() {
+  if (const char* j = std::getenv("MBSGEN_JOBS"); j && *j) {
+    char* end = nullptr;
+    const long n = std::strtol(j, &end, 10);
+    if (*end != '\0' || n < 1 || n > 64)
+      throw std::runtime_error(std::string("MBSGEN_JOBS must be a number from 1 to 64, not '") + j + "'");
+    return static_cast<std::size_t>(n);
+  }
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// The compiler runs that build the solver in work: the kernels' part files first (the longest),
+// then the kernels, the typed API and main, each to an object file; the link is separate. The
+// part files hold only long straight-line arithmetic, which GCC's -O1 compiles in half the time
+// of -O2 and runs as fast (docs/generator.md, "Compiling large models"); the rest takes -O2.
+std::vector<Job> compile_jobs(const Toolchain& tc, const fs::path& work, const GeneratedCode& code,
+                              std::vector<fs::path>& objects) {
+  std::vector<std::pair<std::string, const char*>> units;
+  for (std::size_t k = 0; k < code.parts.size(); ++k)
+    if (code.parts[k].find("namespace") != std::string::npos)  // not an empty part
+      units.push_back({"model_part" + std::to_string(k + 1), "-O1"});
+  for (const char* u : {"model", "model_model", "main"}) units.push_back({u, "-O2"});
+  std::vector<Job> jobs;
+  for (const auto& [unit, level] : units) {
+    std::vector<std::string> args = {tc.compiler, level, "-std=c++17", "-c"};
+    args.insert(args.end(), tc.includes.begin(), tc.includes.end());
+    objects.push_back(work / (unit + ".o"));
+    args.insert(args.end(), {"-I" + work.string(), (work / (unit + ".cpp")).string(), "-o", objects.back().string()});
+    jobs.push_back({args, work / ("compile-" + unit + ".log")});
+  }
+  return jobs;
+}
+
+// Compiles and links the solver in work; false (with a message naming the log) when the
+// compiler failed.
+bool compile_solver(const Toolchain& tc, const fs::path& work, const GeneratedCode& code, std::size_t parallel,
+                    Progress& progress) {
+  std::vector<fs::path> objects;
+  const std::vector<Job> jobs = compile_jobs(tc, work, code, objects);
+  progress.stage("compiling the solver");
+  const std::vector<std::size_t> failed = run_jobs(jobs, parallel, progress);
+  if (failed.empty()) {
+    progress.stage("linking the solver");
+    std::vector<std::string> link = {tc.compiler};
+    for (const auto& o : objects) link.push_back(o.string());
+    link.insert(link.end(), {"-o", (work / "solve").string()});
+    link.insert(link.end(), tc.libraries.begin(), tc.libraries.end());
+    const fs::path log = work / "link.log";
+    int status = 0;
+    const pid_t pid = spawn_program(link, log);
+    while (::waitpid(pid, &status, 0) < 0)
+      if (errno != EINTR) return false;
+    if (exit_status(status) == 0) return true;
+    progress.stop();
+    std::cerr << "mbsgen run: error: linking the solver failed; see " << log.string() << "\n";
+    return false;
+  }
+  progress.stop();
+  std::cerr << "mbsgen run: error: compiling the solver failed; see " << jobs[failed.front()].log.string() << "\n";
+  return false;
+}
+
 // Generates and compiles the solver of model_file into the cache entry dir: in a private
 // directory (mkdtemp) beside it, renamed to dir when complete, so that neither a concurrent nor
-// an interrupted run leaves a half-built entry. Returns false when the compiler failed.
+// an interrupted run leaves a half-built entry. Returns false when the compiler failed. The
+// kernels are split into 2 parts per compiler run at once (EmitOptions::parts), compiled in
+// parallel.
 bool build_solver(const std::string& model_file, const std::string& scene, const std::string& text,
-                  const Toolchain& tc, const fs::path& dir) {
+                  const Toolchain& tc, const fs::path& dir, Progress& progress) {
   const Model full = read_model_file(model_file);
   const Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
+  progress.stage("deriving the equations");
   Equations eq = derive(model);
+  progress.stage("linearizing");
   LinearEquations lin = linearize(eq);
+  progress.stage("checking the operating point");
   check_operating_point(eq, lin);
+  progress.stage("emitting the kernels");
+  const std::size_t parallel = parallel_jobs();
   EmitOptions options;
   options.scene = scene;
   options.source_file = model_file;
   options.id = "model";
+  options.parts = 2 * parallel;
   GeneratedCode code = emit(model, eq, lin, options);
   const auto& range = model.selection().frequency_range;
   GeneratedApi api = emit_api(model, lin, code, scene, range ? range->from_hz : 0.0, range ? range->to_hz : 0.0,
@@ -193,15 +306,7 @@ bool build_solver(const std::string& model_file, const std::string& scene, const
                   "#include \"model_model.hpp\"\n#include \"mbsgen/runtime/solver_cli.hpp\"\n"
                   "int main(int argc, char** argv) { return mbsgen::cli::solver_main(model::kernels(), argc, argv); }\n"},
                  {work / "model.yaml", text}});  // the model this solver was made from, for reference
-    std::vector<std::string> args = {tc.compiler, "-O2", "-std=c++17"};
-    args.insert(args.end(), tc.includes.begin(), tc.includes.end());
-    for (const char* f : {"model.cpp", "model_model.cpp", "main.cpp"}) args.push_back((work / f).string());
-    args.insert(args.end(), {"-I" + work.string(), "-o", (work / "solve").string()});
-    args.insert(args.end(), tc.libraries.begin(), tc.libraries.end());
-    if (run_program(args, work / "compile.log") != 0) {
-      std::cerr << "mbsgen run: error: compiling the solver failed; see " << (work / "compile.log").string() << "\n";
-      return false;
-    }
+    if (!compile_solver(tc, work, code, parallel, progress)) return false;
     write_files({{work / "solve.sum", solver_record(work / "solve")}});  // last: the entry is complete
   } catch (...) {
     std::error_code ec;
@@ -252,12 +357,15 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
       std::cerr << "mbsgen run: the cached solver " << dir.string() << " is damaged (" << why << "): rebuilding it\n";
       fs::remove_all(dir, ec);
     }
-    const bool terminal = ::isatty(STDERR_FILENO);
-    if (terminal) std::cerr << "mbsgen run: generating and compiling the solver of " << model_file << " …" << std::flush;
     const auto t0 = std::chrono::steady_clock::now();
-    if (!build_solver(model_file, scene, text, tc, dir)) return 1;
+    {
+      Progress progress("run");  // on a terminal, after 2 s: the stage, and files compiled
+      if (!build_solver(model_file, scene, text, tc, dir, progress)) return 1;
+    }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (terminal) std::cerr << " " << seconds << " s\n";
+    if (::isatty(STDERR_FILENO))
+      std::cerr << "mbsgen run: built the solver of " << model_file << " in " << std::setprecision(3) << seconds
+                << " s\n";
     why.clear();
     if (!sound_entry(dir, why))
       throw std::runtime_error("the solver just built in " + dir.string() + " is not sound (" + why + ")");

@@ -28,6 +28,15 @@ struct EmitOptions {
   /// scene other than "full"; '_' appended when that is a C++ keyword or `std`). An id given
   /// here must be a C identifier and not reserved (id_problem): emit() throws otherwise.
   std::string id;
+  /// Kernels longer than a few thousand operations are cut into functions of bounded size (the
+  /// compiler's time is superlinear in a function's size); with parts > 0 these functions go to
+  /// `parts` files `<id>_part1.cpp` … `<id>_part<parts>.cpp` of about equal size, to compile in
+  /// parallel (written even when empty, so that a build system can list them in advance).
+  std::size_t parts = 0;
+  /// Operations per part of a long kernel: GCC's compile time per operation is lowest near
+  /// 2,500 (docs/generator.md, "Compiling large models"); 0: no kernel is cut (tests compare the
+  /// two forms bit for bit).
+  std::size_t chunk_operations = 2500;
 };
 
 struct KernelInfo {
@@ -39,6 +48,7 @@ struct KernelInfo {
 struct GeneratedCode {
   std::string id;  ///< C identifier prefix of the kernels
   std::string header, source, manifest;
+  std::vector<std::string> parts;  ///< `<id>_part<k>.cpp` (EmitOptions::parts)
   std::vector<KernelInfo> kernels;
 };
 

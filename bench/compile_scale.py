@@ -1,0 +1,197 @@
+#!/usr/bin/env python3
+"""What a large model costs before its first answer (issue 17 §1, docs/accuracy-vs-time.md).
+
+For N-link spatial chains (bench/spatial_chain_model.py, 2N coordinates) this measures, in one run:
+
+  run      `mbsgen run MODEL -- modes` with an empty solver cache: generation, compilation of the
+           kernels cut into parts (several compilers at once) and the first answer; wall time,
+           CPU time and the peak memory of all its processes together (sampled every 0.1 s)
+  generate `mbsgen generate` alone: its wall time and peak memory, and the operation counts
+  parts    the kernels cut into parts (-O1) and the rest (-O2) compiled as a shared library, 2
+           compilers at once, and the time per call of mass_matrix, residual and linear
+           (bench/kernel_call_timing.cpp, medians of 21 batches)
+  whole    (N <= --whole-max) the same kernels not cut (`--part-operations 0`), the whole file
+           at -O2 in one compiler: the form before issue 17, as the baseline of the time per call
+
+Writes compile_scale.csv into OUT_DIR (one row per N and variant) and prints progress to stderr.
+
+usage: compile_scale.py MBSGEN KERNEL_CALL_TIMING OUT_DIR [--links 10,20,30] [--whole-max 20]
+                        [--jobs 2] [--compiler c++]
+"""
+import argparse
+import csv
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import spatial_chain_model  # noqa: E402
+
+
+def tree_rss_kb(root):
+    """Resident memory of root and all its descendants, in KiB."""
+    children, rss = {}, {}
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            with open("/proc/%s/stat" % pid) as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            with open("/proc/%s/statm" % pid) as f:
+                pages = int(f.read().split()[1])
+        except (OSError, IndexError, ValueError):
+            continue
+        children.setdefault(int(fields[1]), []).append(int(pid))
+        rss[int(pid)] = pages * os.sysconf("SC_PAGE_SIZE") // 1024
+    total, stack = 0, [root]
+    while stack:
+        p = stack.pop()
+        total += rss.get(p, 0)
+        stack.extend(children.get(p, []))
+    return total
+
+
+def measured(cmd, env=None, stdout=subprocess.DEVNULL):
+    """Runs cmd; returns (exit code, wall s, CPU s of it and its children, peak tree RSS KiB)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, env=env, stdout=stdout, stderr=subprocess.PIPE)
+    peak = [0]
+    done = threading.Event()
+
+    def sample():
+        while not done.wait(0.1):
+            peak[0] = max(peak[0], tree_rss_kb(proc.pid))
+
+    sampler = threading.Thread(target=sample)
+    sampler.start()
+    _, err = proc.communicate()
+    done.set()
+    sampler.join()
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    if proc.returncode != 0:
+        sys.stderr.write(err.decode(errors="replace")[-2000:])
+    return proc.returncode, wall, cpu, peak[0]
+
+
+def operation_counts(source):
+    with open(source) as f:
+        for line in f:
+            if line.startswith("// Operation counts"):
+                return {k.split()[0]: int(k.split()[1]) for k in line.split(":", 1)[1].strip().rstrip(";").split(";")}
+    return {}
+
+
+def compile_library(compiler, directory, units, jobs, output):
+    """Compiles units [(source, level)] to objects, `jobs` at once, and links output.so."""
+    t0 = time.perf_counter()
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    pending, running, objects, peak = list(units), [], [], 0
+    while pending or running:
+        while pending and len(running) < jobs:
+            source, level = pending.pop(0)
+            obj = source[:-4] + ".o"
+            objects.append(obj)
+            running.append(subprocess.Popen([compiler, level, "-std=c++17", "-fPIC", "-c", source, "-o", obj,
+                                             "-I", directory]))
+        time.sleep(0.1)
+        peak = max(peak, sum(tree_rss_kb(p.pid) for p in running))
+        for p in list(running):
+            if p.poll() is not None:
+                if p.returncode != 0:
+                    raise RuntimeError("compiling failed: %s" % p.args)
+                running.remove(p)
+    subprocess.run([compiler, "-shared", "-o", output] + objects, check=True)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.perf_counter() - t0, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), peak
+
+
+def kernel_times(timing, library, model_id):
+    out = subprocess.run([timing, library, model_id], check=True, capture_output=True, text=True).stdout
+    times = {}
+    for line in out.splitlines():
+        name, median, lo, hi, checksum = line.split()
+        times[name] = (float(median), float(checksum))
+    return times
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("mbsgen")
+    ap.add_argument("timing")
+    ap.add_argument("out")
+    ap.add_argument("--links", default="10,20,30")
+    ap.add_argument("--whole-max", type=int, default=20)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--compiler", default="c++")
+    args = ap.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    rows = []
+    work = tempfile.mkdtemp(prefix="mbsgen-compile-scale-")
+    try:
+        for n in [int(x) for x in args.links.split(",") if x]:
+            model_id = "spatial_chain_%d" % n
+            model = os.path.join(work, "%s.yaml" % model_id)
+            with open(model, "w") as f:
+                f.write(spatial_chain_model.chain_yaml(n))
+            env = dict(os.environ, MBSGEN_CACHE_DIR=os.path.join(work, "cache-%d" % n), MBSGEN_JOBS=str(args.jobs))
+            sys.stderr.write("[compile_scale] N = %d: mbsgen run -- modes\n" % n)
+            rc, wall, cpu, peak = measured([args.mbsgen, "run", model, "--", "modes"], env=env)
+            row = {"links": n, "coordinates": 2 * n}
+            rows.append(dict(row, variant="run", status="ok" if rc == 0 else "failed", wall_s=wall, cpu_s=cpu,
+                             peak_mb=peak / 1024))
+            sys.stderr.write("[compile_scale] N = %d: mbsgen generate\n" % n)
+            parts = os.path.join(work, "parts-%d" % n)
+            rc, wall, cpu, peak = measured([args.mbsgen, "generate", model, "--out", parts, "--parts", str(2 * args.jobs)])
+            ops = operation_counts(os.path.join(parts, model_id + ".cpp"))
+            rows.append(dict(row, variant="generate", status="ok" if rc == 0 else "failed", wall_s=wall, cpu_s=cpu,
+                             peak_mb=peak / 1024, ops_mass_matrix=ops.get("mass_matrix"),
+                             ops_residual=ops.get("residual"), ops_linear=ops.get("linear"),
+                             ops_total=sum(v for k, v in ops.items() if k != "linear_structured")))
+            units = [(os.path.join(parts, f), "-O1") for f in sorted(os.listdir(parts))
+                     if "_part" in f and f.endswith(".cpp")]
+            units.append((os.path.join(parts, model_id + ".cpp"), "-O2"))
+            sys.stderr.write("[compile_scale] N = %d: compiling the parts\n" % n)
+            wall, cpu, peak = compile_library(args.compiler, parts, units, args.jobs, os.path.join(parts, "lib.so"))
+            t = kernel_times(args.timing, os.path.join(parts, "lib.so"), model_id)
+            variant = dict(row, variant="parts", status="ok", wall_s=wall, cpu_s=cpu, peak_mb=peak / 1024)
+            for k, (median, checksum) in t.items():
+                variant["%s_s" % k] = median
+                variant["%s_checksum" % k] = checksum
+            rows.append(variant)
+            if n <= args.whole_max:
+                sys.stderr.write("[compile_scale] N = %d: the whole kernels (-O2, one file)\n" % n)
+                whole = os.path.join(work, "whole-%d" % n)
+                subprocess.run([args.mbsgen, "generate", model, "--out", whole, "--part-operations", "0"], check=True,
+                               stderr=subprocess.DEVNULL)
+                wall, cpu, peak = compile_library(args.compiler, whole, [(os.path.join(whole, model_id + ".cpp"), "-O2")],
+                                                  1, os.path.join(whole, "lib.so"))
+                t = kernel_times(args.timing, os.path.join(whole, "lib.so"), model_id)
+                variant = dict(row, variant="whole", status="ok", wall_s=wall, cpu_s=cpu, peak_mb=peak / 1024)
+                for k, (median, checksum) in t.items():
+                    variant["%s_s" % k] = median
+                    variant["%s_checksum" % k] = checksum
+                rows.append(variant)
+            shutil.rmtree(parts, ignore_errors=True)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    fields = ["links", "coordinates", "variant", "status", "wall_s", "cpu_s", "peak_mb", "ops_mass_matrix",
+              "ops_residual", "ops_linear", "ops_total", "mass_matrix_s", "residual_s", "linear_s",
+              "mass_matrix_checksum", "residual_checksum", "linear_checksum"]
+    with open(os.path.join(args.out, "compile_scale.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

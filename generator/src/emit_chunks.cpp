@@ -1,0 +1,104 @@
+#include "emit_chunks.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+namespace mbsgen::detail {
+
+namespace {
+
+// The chunk of each statement: a new chunk starts once the current one has max_operations.
+std::vector<std::size_t> assign_chunks(const std::vector<PrintedStatement>& s, std::size_t max_operations,
+                                       std::vector<std::size_t>& operations) {
+  std::vector<std::size_t> chunk(s.size(), 0);
+  operations.assign(1, 0);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (operations.back() >= max_operations) operations.push_back(0);
+    chunk[i] = operations.size() - 1;
+    operations.back() += s[i].operations;
+  }
+  return chunk;
+}
+
+constexpr std::size_t kNoSlot = static_cast<std::size_t>(-1);
+
+}  // namespace
+
+ChunkedBody chunk_body(const std::string& qualifier, const std::string& name, const std::string& parameters,
+                       const std::string& arguments, const std::vector<PrintedStatement>& s,
+                       std::size_t max_operations) {
+  ChunkedBody out;
+  const std::vector<std::size_t> chunk = assign_chunks(s, max_operations, out.operations);
+  const std::size_t chunks = out.operations.size();
+
+  // The last chunk that reads each local defined in an earlier one (chunks: read after them all).
+  std::vector<std::size_t> last_read(s.size(), kNoSlot);
+  std::vector<std::vector<std::size_t>> loads(chunks);
+  for (std::size_t j = 0; j < s.size(); ++j)
+    for (std::size_t i : s[j].reads)
+      if (chunk[i] < chunk[j]) {
+        if (last_read[i] == kNoSlot || last_read[i] < chunk[j]) last_read[i] = chunk[j];
+        loads[chunk[j]].push_back(i);
+      }
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s[i].needed_after) last_read[i] = chunks;
+  for (auto& l : loads) {
+    std::sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
+  }
+
+  // Slots: a value's slot is free again once its last reader has loaded it (at that chunk's top,
+  // before the chunk stores anything).
+  std::vector<std::size_t> slot(s.size(), kNoSlot), free_slots;
+  std::vector<std::vector<std::size_t>> release(chunks + 1);
+  std::size_t i = 0;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    for (std::size_t k : release[c]) free_slots.push_back(k);
+    std::sort(free_slots.begin(), free_slots.end(), std::greater<>());  // lowest slot first
+    for (; i < s.size() && chunk[i] == c; ++i) {
+      if (last_read[i] == kNoSlot) continue;
+      if (free_slots.empty()) {
+        slot[i] = out.workspace++;
+      } else {
+        slot[i] = free_slots.back();
+        free_slots.pop_back();
+      }
+      release[last_read[i]].push_back(slot[i]);
+    }
+  }
+
+  std::ostringstream unused;
+  for (std::size_t a = 0, b = 0; a <= arguments.size(); ++a)
+    if (a == arguments.size() || arguments[a] == ',') {
+      std::string arg = arguments.substr(b, a - b);
+      arg.erase(0, arg.find_first_not_of(' '));
+      unused << "  (void)" << arg << ";\n";
+      b = a + 1;
+    }
+  const std::string signature_tail = "(" + parameters + ", double* w)";
+  for (std::size_t c = 0, j = 0; c < chunks; ++c) {
+    const std::string fn = name + "_" + std::to_string(c);
+    out.declarations += "void " + fn + signature_tail + ";\n";
+    std::ostringstream d;
+    d << "void " << fn << signature_tail << " {\n" << unused.str();
+    for (std::size_t k : loads[c]) d << "  const double " << s[k].defines << " = w[" << slot[k] << "];\n";
+    for (; j < s.size() && chunk[j] == c; ++j) {
+      d << s[j].code;
+      if (slot[j] != kNoSlot) d << "  w[" << slot[j] << "] = " << s[j].defines << ";\n";
+    }
+    d << "}\n";
+    out.definitions.push_back(d.str());
+  }
+
+  std::ostringstream calls;
+  calls << "  // " << chunks << " parts of about " << max_operations << " operations each (emit_chunks.hpp); w: "
+        << "the values that cross from one part to a later one.\n";
+  calls << "  double w[" << std::max<std::size_t>(out.workspace, 1) << "];\n";
+  for (std::size_t c = 0; c < chunks; ++c) calls << "  " << qualifier << name << "_" << c << "(" << arguments << ", w);\n";
+  for (std::size_t k = 0; k < s.size(); ++k)
+    if (s[k].needed_after) calls << "  const double " << s[k].defines << " = w[" << slot[k] << "];\n";
+  out.calls = calls.str();
+  return out;
+}
+
+}  // namespace mbsgen::detail
