@@ -48,20 +48,45 @@ bool even_function(const std::string& name) {
   return even.count(name) > 0;
 }
 
+CanonicalOrder::CanonicalOrder(std::size_t memo_capacity) : capacity_(std::max<std::size_t>(memo_capacity, 1)) {}
+
 void CanonicalOrder::set_sign(const ex& s, int sign) {
   if (!is_a<GiNaC::symbol>(s)) throw std::logic_error("mbsgen::CanonicalOrder::set_sign: not a symbol");
-  auto [it, inserted] = memo_.emplace(s, Signed{text(1, ex_to<GiNaC::symbol>(s).get_name()), sign});
+  auto [it, inserted] = signs_.emplace(s, Signed{text(1, ex_to<GiNaC::symbol>(s).get_name()), sign});
   if (!inserted && it->second.sign != sign)
     throw std::logic_error("mbsgen::CanonicalOrder::set_sign: sign of " +
                            ex_to<GiNaC::symbol>(s).get_name() + " already used");
 }
 
+void CanonicalOrder::remember(const ex& e, Signed r) {
+  if (current_.size() >= capacity_) {
+    // A new generation: what the last two did not use again is forgotten (a key computed again
+    // is the same key).
+    previous_ = std::move(current_);
+    current_ = Memo();
+  }
+  current_.emplace(e, r);
+}
+
 CanonicalOrder::Signed CanonicalOrder::signed_key(const ex& e) {
-  if (auto it = memo_.find(e); it != memo_.end()) return it->second;
-  Signed r{0, 1};
   if (is_a<GiNaC::symbol>(e)) {
-    r.key = text(1, ex_to<GiNaC::symbol>(e).get_name());
-  } else if (is_a<GiNaC::numeric>(e)) {
+    if (auto it = signs_.find(e); it != signs_.end()) return it->second;
+    return {text(1, ex_to<GiNaC::symbol>(e).get_name()), 1};
+  }
+  if (auto it = current_.find(e); it != current_.end()) return it->second;
+  if (auto it = previous_.find(e); it != previous_.end()) {
+    const Signed r = it->second;
+    remember(e, r);
+    return r;
+  }
+  const Signed r = compute(e);
+  remember(e, r);
+  return r;
+}
+
+CanonicalOrder::Signed CanonicalOrder::compute(const ex& e) {
+  Signed r{0, 1};
+  if (is_a<GiNaC::numeric>(e)) {
     GiNaC::numeric n = ex_to<GiNaC::numeric>(e);
     if (n.is_real() && n.is_negative()) {
       r.sign = -1;
@@ -126,7 +151,6 @@ CanonicalOrder::Signed CanonicalOrder::signed_key(const ex& e) {
       r.key = mix(mix(r.key, a.key), static_cast<std::uint64_t>(a.sign + 1));
     }
   }
-  memo_.emplace(e, r);
   return r;
 }
 
@@ -137,11 +161,21 @@ bool CanonicalOrder::less(const ex& a, const ex& b) {
 }
 
 std::vector<ex> CanonicalOrder::operands(const ex& e) {
+  const std::size_t n = e.nops();
   std::vector<ex> ops;
-  ops.reserve(e.nops());
-  for (std::size_t i = 0; i < e.nops(); ++i) ops.push_back(e.op(i));
-  if (commutative(e))
-    std::stable_sort(ops.begin(), ops.end(), [this](const ex& a, const ex& b) { return less(a, b); });
+  ops.reserve(n);
+  if (!commutative(e)) {
+    for (std::size_t i = 0; i < n; ++i) ops.push_back(e.op(i));
+    return ops;
+  }
+  // The order of less(), with each operand's key looked up once rather than at every comparison.
+  std::vector<std::pair<std::uint64_t, ex>> keyed;
+  keyed.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) keyed.emplace_back(key(e.op(i)), e.op(i));
+  std::stable_sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first < b.first : a.second.compare(b.second) < 0;
+  });
+  for (auto& k : keyed) ops.push_back(std::move(k.second));
   return ops;
 }
 

@@ -69,14 +69,40 @@ void Program::collect_intermediates(const ex& e, std::vector<std::size_t>& out) 
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
+namespace {
+
+// Functions (sin, cos, sqrt, …) and non-integer powers: what define() names on its own.
+bool internable(const ex& e) {
+  return is_a<GiNaC::function>(e) ||
+         (is_a<GiNaC::power>(e) &&
+          !(is_a<GiNaC::numeric>(e.op(1)) && ex_to<GiNaC::numeric>(e.op(1)).is_integer()));
+}
+
+bool holds_internable(const ex& e) {
+  std::vector<ex> stack{e};
+  while (!stack.empty()) {
+    const ex x = stack.back();
+    stack.pop_back();
+    if (internable(x)) return true;
+    for (std::size_t i = 0; i < x.nops(); ++i) stack.push_back(x.op(i));
+  }
+  return false;
+}
+
+bool trivial(const ex& e) {  // a number, a symbol or c·symbol: never named
+  return is_a<GiNaC::numeric>(e) || is_a<GiNaC::symbol>(e) ||
+         (is_a<GiNaC::mul>(e) && e.nops() == 2 && is_a<GiNaC::numeric>(e.op(1)) &&
+          is_a<GiNaC::symbol>(e.op(0)));
+}
+
+}  // namespace
+
 // Functions (sin, cos, sqrt, …) and non-integer powers become intermediates of their own, so
 // that sin and cos of each angle are computed once however often derivatives recreate them.
 ex Program::intern_functions(const ex& e) {
   if (is_a<GiNaC::symbol>(e) || is_a<GiNaC::numeric>(e)) return e;
-  bool is_function = is_a<GiNaC::function>(e);
-  bool is_root = is_a<GiNaC::power>(e) && !(is_a<GiNaC::numeric>(e.op(1)) &&
-                                            ex_to<GiNaC::numeric>(e.op(1)).is_integer());
-  if (!is_function && !is_root && e.nops() == 0) return e;
+  const bool named = internable(e);
+  if (!named && e.nops() == 0) return e;
   if (auto it = interned_.find(e); it != interned_.end()) return it->second;
   struct InternChildren : GiNaC::map_function {
     Program* self;
@@ -88,29 +114,43 @@ ex Program::intern_functions(const ex& e) {
   for (const ex& child : order_.operands(e)) intern_functions(child);
   ex mapped = e.nops() > 0 ? e.map(intern_children) : e;
   ex result = mapped;
-  if (is_function || is_root) result = define_node(mapped);
+  if (named) result = define_node(mapped);
   interned_.emplace(e, result);
   return result;
 }
 
 ex Program::define(const ex& e0) {
   if (is_a<GiNaC::numeric>(e0) || is_a<GiNaC::symbol>(e0)) return e0;
-  return define_node(intern_functions(e0));
+  // Without functions and roots there is nothing to intern: no walk that hashes every node
+  // (most definitions are derivatives, polynomials in the intermediates).
+  return holds_internable(e0) ? define_node(intern_functions(e0)) : define_plain(e0);
 }
 
 ex Program::define_node(const ex& e) {
-  if (is_a<GiNaC::numeric>(e) || is_a<GiNaC::symbol>(e)) return e;
-  if (is_a<GiNaC::mul>(e) && e.nops() == 2 && is_a<GiNaC::numeric>(e.op(1)) &&
-      is_a<GiNaC::symbol>(e.op(0)))
-    return e;
+  if (trivial(e)) return e;
   if (auto it = interned_.find(e); it != interned_.end() && is_a<GiNaC::symbol>(it->second))
     return it->second;
+  const ex t = add_definition(e);
+  interned_.emplace(e, t);
+  return t;
+}
+
+ex Program::define_plain(const ex& e) {
+  if (trivial(e)) return e;
+  // The form interning gave an expression with functions has its symbol; an expression without
+  // any is named anew (intern_functions records it as itself, not as a symbol), and CSE merges
+  // equal temporaries when a kernel is emitted.
+  if (auto it = interned_.find(e); it != interned_.end() && is_a<GiNaC::symbol>(it->second))
+    return it->second;
+  return add_definition(e);
+}
+
+ex Program::add_definition(const ex& e) {
   GiNaC::symbol t("t" + std::to_string(defs_.size()));
   order_.set_sign(t, order_.sign(e));
   deps_.push_back(dependencies(e));
   defs_.push_back({t, e});
   def_index_.emplace(t, defs_.size() - 1);
-  interned_.emplace(e, t);
   return t;
 }
 
@@ -142,7 +182,10 @@ ex Program::diff_intermediate(std::size_t k, std::size_t variable) {
       for (std::size_t i : it->second) terms.push_back(value.op(i));
     value = GiNaC::add(terms);
   }
-  ex d = define(diff(value, variables_[variable]));
+  // A value holds functions and roots only at its top (define() names those inside), and the
+  // derivative of one that holds none holds none either: nothing to intern.
+  const ex d = internable(value) ? define(diff(value, variables_[variable]))
+                                 : define_plain(diff(value, variables_[variable]));
   diff_memo_.emplace(key, d);
   return d;
 }
@@ -160,6 +203,59 @@ const Program::SumIndex& Program::sum_index(std::size_t k) {
   return sum_index_.emplace(k, std::move(index)).first->second;
 }
 
+// ∂e/∂s for each symbol s of e, differentiating only the terms of a sum that hold s: the same
+// expression as e.diff(s) (whose other terms differentiate to 0), without building a zero for
+// every other term at every symbol.
+class Program::Partials {
+ public:
+  Partials(const Program& program, const ex& e, const GiNaC::symbol& x) : e_(e) {
+    if (!is_a<GiNaC::add>(e)) return;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      std::vector<std::size_t> ts;
+      bool has_x = false;
+      program.collect_symbols(e.op(i), x, ts, has_x);
+      for (std::size_t k : ts) terms_of_[k].push_back(i);
+      if (has_x) terms_of_x_.push_back(i);
+    }
+  }
+  /// ∂e/∂x.
+  ex of_variable(const GiNaC::symbol& x) const { return partial(x, terms_of_x_); }
+  /// ∂e/∂t_k for intermediate k with symbol t.
+  ex of_intermediate(std::size_t k, const GiNaC::symbol& t) const {
+    auto it = terms_of_.find(k);
+    return partial(t, it == terms_of_.end() ? std::vector<std::size_t>{} : it->second);
+  }
+
+ private:
+  ex partial(const GiNaC::symbol& s, const std::vector<std::size_t>& terms) const {
+    if (!is_a<GiNaC::add>(e_)) return e_.diff(s);
+    GiNaC::exvector v;
+    v.reserve(terms.size());
+    for (std::size_t i : terms) v.push_back(e_.op(i).diff(s));
+    return GiNaC::add(v);
+  }
+  const ex& e_;
+  std::unordered_map<std::size_t, std::vector<std::size_t>> terms_of_;
+  std::vector<std::size_t> terms_of_x_;
+};
+
+void Program::collect_symbols(const ex& e, const GiNaC::symbol& x, std::vector<std::size_t>& out,
+                              bool& has_x) const {
+  std::vector<ex> stack{e};
+  while (!stack.empty()) {
+    ex y = stack.back();
+    stack.pop_back();
+    if (is_a<GiNaC::symbol>(y)) {
+      if (auto d = def_index_.find(y); d != def_index_.end()) out.push_back(d->second);
+      else if (y.is_equal(x)) has_x = true;
+      continue;
+    }
+    for (std::size_t i = 0; i < y.nops(); ++i) stack.push_back(y.op(i));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
 ex Program::diff(const ex& e, const GiNaC::symbol& x) {
   const std::size_t var = variable(x, "diff");
   if (is_a<GiNaC::numeric>(e)) return 0;
@@ -170,13 +266,15 @@ ex Program::diff(const ex& e, const GiNaC::symbol& x) {
   }
   std::vector<std::size_t> ts;
   collect_intermediates(e, ts);
-  ex result = e.diff(x);
+  const Partials partials(*this, e, x);
+  // ∂e/∂x + Σ ∂e/∂t_k dt_k/dx, summed once (adding term by term rebuilt the sum each time).
+  GiNaC::exvector terms{partials.of_variable(x)};
   for (std::size_t k : ts) {
     ex dt = diff_intermediate(k, var);
     if (dt.is_zero()) continue;
-    result += e.diff(defs_[k].symbol) * dt;
+    terms.push_back(partials.of_intermediate(k, defs_[k].symbol) * dt);
   }
-  return result;
+  return GiNaC::add(terms);
 }
 
 ex Program::substitute_intermediate(std::size_t k, Substitution& s) {

@@ -13,7 +13,9 @@
 
 #include <ginac/ginac.h>
 
+#include <cstddef>
 #include <cstdint>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -21,6 +23,14 @@ namespace mbsgen {
 
 class CanonicalOrder {
  public:
+  /// Compound expressions whose keys are remembered before the memo starts a new generation
+  /// (see memo_size()). Keys are pure functions of the expression, so what is forgotten is only
+  /// computed again: the capacity changes the time, never a key. 2^18 entries (about 15 MB)
+  /// hold the working set of one kernel of the 80-coordinate spatial chain.
+  static constexpr std::size_t kDefaultMemoCapacity = std::size_t{1} << 18;
+
+  explicit CanonicalOrder(std::size_t memo_capacity = kDefaultMemoCapacity);
+
   struct Signed {
     std::uint64_t key;
     int sign;  // +1 or −1
@@ -43,8 +53,20 @@ class CanonicalOrder {
   /// True when a precedes b (ties, which need a 64-bit collision, fall back to GiNaC's order).
   bool less(const GiNaC::ex& a, const GiNaC::ex& b);
 
+  /// Keys of compound expressions now remembered: at most twice the capacity (the generation
+  /// being filled and the one before it, whose entries move forward when used again).
+  std::size_t memo_size() const { return current_.size() + previous_.size(); }
+  /// Symbols declared by set_sign (kept for good: a sign cannot be computed again).
+  std::size_t signed_symbols() const { return signs_.size(); }
+
  private:
-  std::unordered_map<GiNaC::ex, Signed, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> memo_;
+  using Memo = std::unordered_map<GiNaC::ex, Signed, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
+  Signed compute(const GiNaC::ex& e);
+  void remember(const GiNaC::ex& e, Signed r);
+
+  std::size_t capacity_;
+  Memo signs_;              // symbols declared by set_sign
+  Memo current_, previous_;  // compound expressions and numbers, two generations
 };
 
 /// Odd (f(−x) = −f(x)) and even (f(−x) = f(x)) functions of one argument, by GiNaC name.

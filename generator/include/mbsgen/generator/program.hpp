@@ -30,7 +30,9 @@ class Program {
   void add_variable(const GiNaC::symbol& s);
 
   /// Names `e` as an intermediate and returns its symbol; numbers, symbols and c·symbol are
-  /// returned as they are, and an expression defined before returns its old symbol.
+  /// returned as they are. Functions and non-integer powers in e are named once each, and an
+  /// expression holding them that was defined before returns its old symbol; an expression
+  /// without them is named anew (emission merges equal temporaries).
   GiNaC::ex define(const GiNaC::ex& e);
 
   /// Total derivative de/dx through the intermediates (x a registered variable).
@@ -69,8 +71,14 @@ class Program {
   Bits dependencies(const GiNaC::ex& e) const;
   std::size_t variable(const GiNaC::symbol& x, const char* caller) const;
   void collect_intermediates(const GiNaC::ex& e, std::vector<std::size_t>& out) const;
+  // The intermediates of e (sorted, once each), and whether e holds the variable x.
+  void collect_symbols(const GiNaC::ex& e, const GiNaC::symbol& x, std::vector<std::size_t>& out,
+                       bool& has_x) const;
+  class Partials;
   GiNaC::ex intern_functions(const GiNaC::ex& e);
   GiNaC::ex define_node(const GiNaC::ex& e);
+  GiNaC::ex define_plain(const GiNaC::ex& e);  // define() of e without functions and roots
+  GiNaC::ex add_definition(const GiNaC::ex& e);
   GiNaC::ex diff_intermediate(std::size_t k, std::size_t variable);
   GiNaC::ex substitute_intermediate(std::size_t k, Substitution& s);
   bool bits_intersect(const Bits& a, const Bits& b) const;
