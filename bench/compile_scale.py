@@ -9,7 +9,8 @@ For N-link spatial chains (bench/spatial_chain_model.py, 2N coordinates) this me
   generate `mbsgen generate` alone: its wall time and peak memory, and the operation counts
   parts    the kernels cut into parts (-O1) and the rest (-O2) compiled as a shared library, 2
            compilers at once, and the time per call of mass_matrix, residual and linear
-           (bench/kernel_call_timing.cpp, medians of 21 batches)
+           (bench/kernel_call_timing.cpp: thread CPU time, medians of 51 batches, the variants
+           timed in turn in one process)
   whole    (N <= --whole-max) the same kernels not cut (`--part-operations 0`), the whole file
            at -O2 in one compiler: the form before issue 17, as the baseline of the time per call
 
@@ -113,12 +114,13 @@ def compile_library(compiler, directory, units, jobs, output):
     return time.perf_counter() - t0, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), peak
 
 
-def kernel_times(timing, library, model_id):
-    out = subprocess.run([timing, library, model_id], check=True, capture_output=True, text=True).stdout
+def kernel_times(timing, model_id, libraries):
+    """{library index: {kernel: (median s, checksum)}}, the libraries timed in turn in one process."""
+    out = subprocess.run([timing, model_id] + libraries, check=True, capture_output=True, text=True).stdout
     times = {}
     for line in out.splitlines():
-        name, median, lo, hi, checksum = line.split()
-        times[name] = (float(median), float(checksum))
+        index, name, median, checksum = line.split()
+        times.setdefault(int(index), {})[name] = (float(median), float(checksum))
     return times
 
 
@@ -160,12 +162,8 @@ def main():
             units.append((os.path.join(parts, model_id + ".cpp"), "-O2"))
             sys.stderr.write("[compile_scale] N = %d: compiling the parts\n" % n)
             wall, cpu, peak = compile_library(args.compiler, parts, units, args.jobs, os.path.join(parts, "lib.so"))
-            t = kernel_times(args.timing, os.path.join(parts, "lib.so"), model_id)
-            variant = dict(row, variant="parts", status="ok", wall_s=wall, cpu_s=cpu, peak_mb=peak / 1024)
-            for k, (median, checksum) in t.items():
-                variant["%s_s" % k] = median
-                variant["%s_checksum" % k] = checksum
-            rows.append(variant)
+            variants = [dict(row, variant="parts", status="ok", wall_s=wall, cpu_s=cpu, peak_mb=peak / 1024)]
+            libraries = [os.path.join(parts, "lib.so")]
             if n <= args.whole_max:
                 sys.stderr.write("[compile_scale] N = %d: the whole kernels (-O2, one file)\n" % n)
                 whole = os.path.join(work, "whole-%d" % n)
@@ -173,11 +171,13 @@ def main():
                                stderr=subprocess.DEVNULL)
                 wall, cpu, peak = compile_library(args.compiler, whole, [(os.path.join(whole, model_id + ".cpp"), "-O2")],
                                                   1, os.path.join(whole, "lib.so"))
-                t = kernel_times(args.timing, os.path.join(whole, "lib.so"), model_id)
-                variant = dict(row, variant="whole", status="ok", wall_s=wall, cpu_s=cpu, peak_mb=peak / 1024)
-                for k, (median, checksum) in t.items():
-                    variant["%s_s" % k] = median
-                    variant["%s_checksum" % k] = checksum
+                variants.append(dict(row, variant="whole", status="ok", wall_s=wall, cpu_s=cpu, peak_mb=peak / 1024))
+                libraries.append(os.path.join(whole, "lib.so"))
+            times = kernel_times(args.timing, model_id, libraries)
+            for k, variant in enumerate(variants):
+                for kernel, (median, checksum) in times[k].items():
+                    variant["%s_s" % kernel] = median
+                    variant["%s_checksum" % kernel] = checksum
                 rows.append(variant)
             shutil.rmtree(parts, ignore_errors=True)
     finally:

@@ -1,16 +1,21 @@
-// Time per call of a generated model's mass_matrix, residual and linear kernels, loaded from a
-// shared library (issue 17 §1: the kernels cut into parts and compiled at -O1 against the whole
-// kernels at -O2, the form before issue 17). Run by bench/compile_scale.py; prints one line per
-// kernel: "<kernel> <median_s> <min_s> <max_s> <checksum>", the checksum a sum of the outputs at
-// a fixed state, so that two builds of the same model can be seen to compute the same numbers.
+// Time per call of generated models' mass_matrix, residual and linear kernels, loaded from
+// shared libraries (issue 17 §1: the kernels cut into parts and compiled at -O1 against the whole
+// kernels at -O2, the form before issue 17). Run by bench/compile_scale.py. The libraries are
+// timed in one process, batch after batch in turn (51 rounds of batches of about 2 ms each), in
+// thread CPU time: on a shared machine a wall-clock comparison of two runs was off by 50 % (the
+// other jobs' load changes between them), interleaved CPU time by a few per cent. Prints one
+// line per library and kernel: "<library index> <kernel> <median_s> <checksum>", the checksum a
+// sum of the outputs at a fixed state, so that builds of the same model can be seen to compute
+// the same numbers.
 //
-//   kernel_call_timing LIBRARY ID
-#include "harness.hpp"
-
+//   kernel_call_timing ID LIBRARY...
 #include <dlfcn.h>
+#include <time.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,6 +25,12 @@ using MassMatrix = int (*)(const double*, const double*, double*);
 using Residual = int (*)(const double*, const double*, const double*, const double*, double*);
 using Linear = int (*)(const double*, const double*, const double*, double*, double*, double*, double*, double*,
                        double*);
+
+double thread_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 std::size_t count(const char* const* names) {
   std::size_t n = 0;
@@ -33,50 +44,110 @@ double sum(const std::vector<double>& v) {
   return s;
 }
 
-void report(const char* kernel, const bench::Timing& t, double checksum) {
-  std::printf("%s %.6g %.6g %.6g %.17g\n", kernel, t.median, t.min, t.max, checksum);
+// One library's kernels and buffers.
+struct Model {
+  const double* p = nullptr;
+  std::size_t f = 0, m = 0, r = 0;
+  MassMatrix mass_matrix = nullptr;
+  Residual residual = nullptr;
+  Linear linear = nullptr;
+  std::vector<double> y, yd, u, M, Q, K, B, Cy, Cv, res;
+};
+
+bool load(const char* path, const std::string& id, Model& model) {
+  void* lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+  if (!lib) {
+    std::fprintf(stderr, "kernel_call_timing: %s\n", dlerror());
+    return false;
+  }
+  auto symbol = [&](const char* name) { return dlsym(lib, (id + name).c_str()); };
+  model.p = static_cast<const double*>(symbol("_parameter_defaults"));
+  model.f = count(static_cast<const char* const*>(symbol("_coordinate_names")));
+  model.m = count(static_cast<const char* const*>(symbol("_input_names")));
+  model.r = count(static_cast<const char* const*>(symbol("_output_names")));
+  model.mass_matrix = reinterpret_cast<MassMatrix>(symbol("_mass_matrix"));
+  model.residual = reinterpret_cast<Residual>(symbol("_residual"));
+  model.linear = reinterpret_cast<Linear>(symbol("_linear"));
+  if (!model.p || model.f == 0 || !model.mass_matrix || !model.residual || !model.linear) {
+    std::fprintf(stderr, "kernel_call_timing: %s lacks the kernels of %s\n", path, id.c_str());
+    return false;
+  }
+  const std::size_t f = model.f;
+  // A state away from the operating point (no exact zeros), the same for every build.
+  model.y.resize(f);
+  model.yd.resize(f);
+  for (std::size_t i = 0; i < f; ++i) {
+    model.y[i] = 0.3 * std::sin(1.7 * static_cast<double>(i) + 1);
+    model.yd[i] = 0.2 * std::cos(0.9 * static_cast<double>(i));
+  }
+  model.u.assign(std::max<std::size_t>(model.m, 1), 0.0);
+  model.M.resize(f * f);
+  model.Q.resize(f * f);
+  model.K.resize(f * f);
+  model.B.resize(std::max<std::size_t>(f * model.m, 1));
+  model.Cy.resize(std::max<std::size_t>(model.r * f, 1));
+  model.Cv.resize(model.Cy.size());
+  model.res.resize(f);
+  return true;
+}
+
+// Median seconds per call of each of the calls, timed in turn.
+std::vector<double> interleaved(const std::vector<std::function<void()>>& calls) {
+  std::vector<long> batch(calls.size(), 1);
+  for (std::size_t k = 0; k < calls.size(); ++k) {  // size the batches to about 2 ms
+    const double t0 = thread_seconds();
+    calls[k]();
+    const double once = std::max(thread_seconds() - t0, 1e-8);
+    batch[k] = std::max(1L, static_cast<long>(2e-3 / once));
+  }
+  std::vector<std::vector<double>> per_call(calls.size());
+  for (int round = 0; round < 51; ++round)
+    for (std::size_t k = 0; k < calls.size(); ++k) {
+      const double t0 = thread_seconds();
+      for (long c = 0; c < batch[k]; ++c) calls[k]();
+      per_call[k].push_back((thread_seconds() - t0) / static_cast<double>(batch[k]));
+    }
+  std::vector<double> medians;
+  for (auto& v : per_call) {
+    std::sort(v.begin(), v.end());
+    medians.push_back(v[v.size() / 2]);
+  }
+  return medians;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: kernel_call_timing LIBRARY ID\n");
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: kernel_call_timing ID LIBRARY...\n");
     return 2;
   }
-  void* lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
-  if (!lib) {
-    std::fprintf(stderr, "kernel_call_timing: %s\n", dlerror());
-    return 1;
+  const std::string id = argv[1];
+  std::vector<Model> models(static_cast<std::size_t>(argc - 2));
+  for (std::size_t k = 0; k < models.size(); ++k)
+    if (!load(argv[k + 2], id, models[k])) return 1;
+  for (const char* kernel : {"mass_matrix", "residual", "linear"}) {
+    std::vector<std::function<void()>> calls;
+    for (auto& x : models) {
+      Model* q = &x;
+      if (std::string(kernel) == "mass_matrix")
+        calls.push_back([q] { q->mass_matrix(q->y.data(), q->p, q->M.data()); });
+      else if (std::string(kernel) == "residual")
+        calls.push_back([q] { q->residual(q->y.data(), q->yd.data(), q->u.data(), q->p, q->res.data()); });
+      else
+        calls.push_back([q] {
+          q->linear(q->y.data(), q->yd.data(), q->p, q->M.data(), q->Q.data(), q->K.data(), q->B.data(), q->Cy.data(),
+                    q->Cv.data());
+        });
+    }
+    const std::vector<double> t = interleaved(calls);
+    for (std::size_t k = 0; k < models.size(); ++k) {
+      const Model& q = models[k];
+      const double checksum = std::string(kernel) == "mass_matrix" ? sum(q.M)
+                              : std::string(kernel) == "residual"  ? sum(q.res)
+                                                                   : sum(q.M) + sum(q.Q) + sum(q.K);
+      std::printf("%zu %s %.6g %.17g\n", k, kernel, t[k], checksum);
+    }
   }
-  const std::string id = argv[2];
-  auto symbol = [&](const char* name) { return dlsym(lib, (id + name).c_str()); };
-  const auto* p = static_cast<const double*>(symbol("_parameter_defaults"));
-  const std::size_t f = count(static_cast<const char* const*>(symbol("_coordinate_names")));
-  const std::size_t m = count(static_cast<const char* const*>(symbol("_input_names")));
-  const std::size_t r = count(static_cast<const char* const*>(symbol("_output_names")));
-  auto mass_matrix = reinterpret_cast<MassMatrix>(symbol("_mass_matrix"));
-  auto residual = reinterpret_cast<Residual>(symbol("_residual"));
-  auto linear = reinterpret_cast<Linear>(symbol("_linear"));
-  if (!p || f == 0 || !mass_matrix || !residual || !linear) {
-    std::fprintf(stderr, "kernel_call_timing: %s lacks the kernels of %s\n", argv[1], id.c_str());
-    return 1;
-  }
-  // A state away from the operating point (no exact zeros), the same for every build.
-  std::vector<double> y(f), yd(f), u(std::max<std::size_t>(m, 1), 0.0);
-  for (std::size_t i = 0; i < f; ++i) {
-    y[i] = 0.3 * std::sin(1.7 * static_cast<double>(i) + 1);
-    yd[i] = 0.2 * std::cos(0.9 * static_cast<double>(i));
-  }
-  std::vector<double> M(f * f), Q(f * f), K(f * f), B(std::max<std::size_t>(f * m, 1)),
-      Cy(std::max<std::size_t>(r * f, 1)), Cv(Cy.size()), res(f);
-  const int reps = 21;
-  mass_matrix(y.data(), p, M.data());
-  report("mass_matrix", bench::time_calls([&] { mass_matrix(y.data(), p, M.data()); }, reps), sum(M));
-  residual(y.data(), yd.data(), u.data(), p, res.data());
-  report("residual", bench::time_calls([&] { residual(y.data(), yd.data(), u.data(), p, res.data()); }, reps), sum(res));
-  auto call_linear = [&] { linear(y.data(), yd.data(), p, M.data(), Q.data(), K.data(), B.data(), Cy.data(), Cv.data()); };
-  call_linear();
-  report("linear", bench::time_calls(call_linear, reps), sum(M) + sum(Q) + sum(K));
   return 0;
 }

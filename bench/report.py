@@ -16,6 +16,7 @@ import subprocess
 import sys
 
 from report_engines import engines_section  # issue 17 §2: MuJoCo and KDL (bench/engines.sh)
+from report_scale import section as scale_section  # issue 17 §1: large models (bench/compile_scale.py)
 
 RESULTS, OUTPUT, IMAGES = sys.argv[1], sys.argv[2], sys.argv[3]
 F_REPORT = 100  # frequencies per sweep in frf_accuracy (kF)
@@ -634,6 +635,7 @@ if series["t"]:
     w(gnuplot("generation", body, size=(960, 720)))
     w("")
 
+out.extend(scale_section(RESULTS, table, ftime))
 w(engines_section(RESULTS))
 
 # ---- 5. conclusions ----

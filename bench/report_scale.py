@@ -60,7 +60,7 @@ def section(results, table, ftime):
                           ftime(_num(whole.get("wall_s")))])
             else:
                 t.append([str(n), k, ftime(a), "–", "–", "–", "–"])
-    out += ["Time per call (medians of 21 batches, `bench/kernel_call_timing.cpp`): the kernels cut into parts "
+    out += ["Time per call (thread CPU time, medians of 51 batches with the variants in turn, `bench/kernel_call_timing.cpp`): the kernels cut into parts "
             "(-O1) against the whole kernels in one function each (`--part-operations 0`, -O2, one compiler: "
             "the form before issue 17), where that still compiles within the run's budget; \"same\" = the "
             "checksums of the outputs agree bit for bit.", "",

@@ -59,7 +59,7 @@ out=${out:-$build/results}
 log "configuring $build (Release, benchmarks on, tests off)"
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DMBSGEN_BUILD_BENCH=ON -DMBSGEN_BUILD_TESTS=OFF >/dev/null
 log "building frf_accuracy modes_accuracy generation_cost (-j $jobs)"
-cmake --build "$build" --target frf_accuracy modes_accuracy generation_cost -j "$jobs" >/dev/null
+cmake --build "$build" --target frf_accuracy modes_accuracy generation_cost kernel_call_timing mbsgen -j "$jobs" >/dev/null
 rm -rf "$out"
 mkdir -p "$out"
 
@@ -104,6 +104,14 @@ log "modes (modes_accuracy ${q[*]:-})"
 "$build/bench/modes_accuracy" "$out" "${q[@]}" 2>"$out/modes.log"
 log "generation (generation_cost ${q[*]:-})"
 "$build/bench/generation_cost" "$out" "${q[@]}" 2>"$out/generation.log"
+# Large models (issue 17 §1): the spatial chains from model file to first answer, compile time and
+# memory, and the kernels cut into parts against the whole ones (compiled only to N = 20: the
+# 30-link chain's whole file takes GCC about 9 minutes and 3.5 GB).
+if [ $quick -eq 1 ]; then scale_links="10,20"; whole_max=10; else scale_links="10,20,30,40,60"; whole_max=20; fi
+log "large models (compile_scale.py, links $scale_links)"
+"$python" bench/compile_scale.py "$build/generator/mbsgen" "$build/bench/kernel_call_timing" "$out" \
+  --links "$scale_links" --whole-max "$whole_max" --jobs "$(env -u OMP_NUM_THREADS nproc)" 2>"$out/compile_scale.log" ||
+  log "compile_scale: failed (see $out/compile_scale.log)"
 
 # ---- peers --------------------------------------------------------------------------------------
 if [ $quick -eq 1 ]; then sympy_sizes="2 5"; sympy_limit=60; oct_limit=60; else sympy_sizes="2 5 10 20 40"; sympy_limit=180; oct_limit=240; fi

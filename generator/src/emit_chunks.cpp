@@ -22,11 +22,56 @@ std::vector<std::size_t> assign_chunks(const std::vector<PrintedStatement>& s, s
 
 constexpr std::size_t kNoSlot = static_cast<std::size_t>(-1);
 
+// The statements in the order the outputs demand them: each output (in its original order) right
+// after the locals it reads that are not yet computed, those in their original order, depth
+// first. Values are then computed near their use, so that few cross a part's boundary (the
+// emitter's order defines every intermediate before the first output: the 40-coordinate chain's
+// mass matrix loaded 1,866 values from the workspace and stored 1,272 in parts of 14,742
+// operations, 20 % more instructions). The order of independent statements does not change a
+// single value.
+std::vector<PrintedStatement> demand_order(const std::vector<PrintedStatement>& s) {
+  std::vector<char> placed(s.size(), 0);
+  std::vector<std::size_t> order;
+  order.reserve(s.size());
+  for (std::size_t root = 0; root < s.size(); ++root) {
+    if (!s[root].defines.empty() && !s[root].needed_after) continue;  // a local: placed on demand
+    // Post-order walk from the output, children in their original (definition) order.
+    std::vector<std::pair<std::size_t, std::size_t>> stack{{root, 0}};
+    while (!stack.empty()) {
+      auto& [i, next] = stack.back();
+      if (placed[i]) {
+        stack.pop_back();
+        continue;
+      }
+      if (next < s[i].reads.size()) {
+        const std::size_t child = s[i].reads[next++];
+        if (!placed[child]) stack.push_back({child, 0});
+        continue;
+      }
+      placed[i] = 1;
+      order.push_back(i);
+      stack.pop_back();
+    }
+  }
+  for (std::size_t i = 0; i < s.size(); ++i)  // locals no output reads (none in practice)
+    if (!placed[i]) order.push_back(i);
+  std::vector<std::size_t> position(s.size());
+  for (std::size_t k = 0; k < order.size(); ++k) position[order[k]] = k;
+  std::vector<PrintedStatement> out;
+  out.reserve(s.size());
+  for (std::size_t i : order) {
+    out.push_back(s[i]);
+    for (auto& r : out.back().reads) r = position[r];
+  }
+  return out;
+}
+
 }  // namespace
 
 ChunkedBody chunk_body(const std::string& qualifier, const std::string& name, const std::string& parameters,
-                       const std::string& arguments, const std::vector<PrintedStatement>& s,
+                       const std::string& arguments, const std::vector<PrintedStatement>& statements,
                        std::size_t max_operations) {
+  const std::vector<PrintedStatement> s = demand_order(statements);
   ChunkedBody out;
   const std::vector<std::size_t> chunk = assign_chunks(s, max_operations, out.operations);
   const std::size_t chunks = out.operations.size();
