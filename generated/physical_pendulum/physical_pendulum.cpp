@@ -15,6 +15,21 @@ bool all_finite(const double* x, int n) {
 inline bool at_operating_point(double argument, double value) {
   return argument == value || std::fabs(argument - value) <= 8 * 2.220446049250313e-16 * std::fabs(value);
 }
+// Splits X (n×n, column-major) in place into its symmetric part (X + Xᵀ)/2, left in X, and its
+// skew part (X − Xᵀ)/2 in A; an entry marked '0' in sym or skew (column-major) is an exact zero.
+void split_symmetric(double* X, double* A, int n, const char* sym, const char* skew) {
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < j; ++i) {
+      const int ij = i + n * j, ji = j + n * i;
+      const double x = X[ij], y = X[ji];
+      X[ij] = X[ji] = sym[ij] == '0' ? 0.0 : 0.5 * (x + y);
+      A[ij] = skew[ij] == '0' ? 0.0 : 0.5 * (x - y);
+      A[ji] = skew[ij] == '0' ? 0.0 : 0.5 * (y - x);
+    }
+    if (sym[j + n * j] == '0') X[j + n * j] = 0.0;
+    A[j + n * j] = 0.0;
+  }
+}
 }  // namespace
 
 extern "C" int physical_pendulum_abi_version(void) { return 1; }
@@ -92,20 +107,12 @@ extern "C" int physical_pendulum_linear_structured(const double* y0, const doubl
   (void)y0;
   (void)yd0;
   (void)p;
-  const double t0 = std::cos(y0[0]);
-  const double t1 = std::sin(y0[0]);
-  const double t2 = 0.5*p[1]*t1;
-  const double t3 = t0*0.5*p[1];
-  const double t8 = (p[1]*p[1])*p[0]*0.083333333333333329;
-  const double t15 = t8 + p[0]*((t2*t2) + (t3*t3));
-  const double t23 = p[0]*t3;
-  const double t24 = t23*p[2];
-  M[0] = t15;
-  D[0] = 0.0;
-  G[0] = 0.0;
-  Ks[0] = t24;
-  N[0] = 0.0;
+  double B_linear[1], Cy_linear[1], Cv_linear[1];
+  const int computed_status = physical_pendulum_linear(y0, yd0, p, M, D, Ks, B_linear, Cy_linear, Cv_linear);
+  split_symmetric(D, G, 1, "0", "0");
+  split_symmetric(Ks, N, 1, "x", "0");
   int status = 0;
+  if (computed_status > 1) return computed_status;
   if (!all_finite(M, 1)) status = 1;
   if (!all_finite(D, 1)) status = 1;
   if (!all_finite(G, 1)) status = 1;
