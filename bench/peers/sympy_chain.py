@@ -5,14 +5,25 @@ Builds the N-link planar chain of mbsgen::planar_chain (generator/src/chain.cpp)
 sympy.physics.mechanics.KanesMethod — point masses m_i at the ends of massless rods l_i,
 revolute joints about z with relative angles q_i (q_1 from the downward vertical), a torsional
 spring k_i and damper c_i on each relative angle, gravity g along -y — derives the equations of
-motion (kanes_equations), linearizes them at rest about any q (u = 0, q symbolic, like mbsgen's
-`linear` kernel, whose operating point y0 is an argument; KanesMethod.linearize with
-A_and_B=False, i.e. without inverting M symbolically) and prints, as it goes, one "key value"
-line per result so that a run stopped by a time limit still reports what it finished:
+motion (kanes_equations) and prints, as it goes, one "key value" line per result so that a run
+stopped by a time limit still reports what it finished:
 
-  sympy_version, derive_s, ops_mass_forcing, linearize_s, ops_linear, cse_s, ops_linear_cse,
+  sympy_version, derive_s, ops_mass_forcing
+  mck_s, ops_mck_cse, ops_mck_q0_cse: M, C, K at rest (u = 0) straight from the equations of
+      motion M(q) u' = f(q, u): M, C = -df/du, K = -df/dq, each entry as mbsgen's `linear`
+      kernel has it (same signs, no kinematic rows); sympy.cse of all three about any q (like
+      the kernel, whose operating point y0 is an argument) and with q = 0 substituted (the
+      figures of issue 17 §3: 265 at N = 6, 989 at N = 10)
+  linearize_s, ops_linear, cse_s, ops_linear_cse: KanesMethod.linearize at rest about any q
+      (A_and_B=False, i.e. without inverting M symbolically) and sympy.cse of its M_l and A_l
   max_rel_diff (M, C, K at q = 0 with mbsgen's default parameters against the matrices of
-  generation_cost in GEN_MATRICES, when given), done
+      generation_cost in GEN_MATRICES, when given), done
+
+Operations are sympy.count_ops of the expressions with the coordinates and speeds as plain
+symbols: count_ops counts each q_i(t) of a dynamicsymbol as one operation (FUNC), which a
+generated kernel reads from a variable (this added 2 to 4 at N = 2 before; ops_linear_cse 51
+became 47). Ours are the operations of the emitted kernel (+, -, *, /, calls), where x**k is
+k - 1 products and count_ops says 1: a difference that favours SymPy.
 
 usage: /usr/bin/python3 bench/peers/sympy_chain.py N [GEN_MATRICES_FILE]
 Run by scripts/bench.sh under `timeout`; needs Debian's python3-sympy.
@@ -61,8 +72,19 @@ def build(n):
     return km, particles, loads, q, u, params
 
 
-def ops(matrix):
-    return sum(sp.count_ops(e) for e in matrix)
+def plain(q, u):
+    """Coordinates and speeds q_i(t), u_i(t) -> plain symbols, for count_ops (see the docstring)."""
+    names = ["q%d" % (i + 1) for i in range(len(q))] + ["u%d" % (i + 1) for i in range(len(u))]
+    return dict(zip(list(q) + list(u), sp.symbols(names)))
+
+
+def ops(exprs, symbols):
+    return sum(sp.count_ops(sp.sympify(e).xreplace(symbols)) for e in exprs)
+
+
+def ops_after_cse(exprs, symbols):
+    replacements, reduced = sp.cse([sp.sympify(e).xreplace(symbols) for e in exprs])
+    return sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced)
 
 
 def read_matrices(path):
@@ -88,18 +110,27 @@ def main():
     km, particles, loads, q, u, params = build(n)
     km.kanes_equations(particles, loads)
     say("derive_s", "%.4g" % (time.perf_counter() - t0))
-    say("ops_mass_forcing", ops(km.mass_matrix) + ops(km.forcing))
-    t0 = time.perf_counter()
+    symbols = plain(q, u)
+    say("ops_mass_forcing", ops(km.mass_matrix, symbols) + ops(km.forcing, symbols))
     # At rest (u = 0) but about any q, as mbsgen's `linear` kernel, which takes the operating
-    # point y0 as an argument (q = 0 substituted here would fold sin and cos into constants).
+    # point y0 as an argument (q = 0 substituted folds sin and cos into constants).
     op = {ui: 0 for ui in u}
+    t0 = time.perf_counter()
+    M = km.mass_matrix
+    C = -km.forcing.jacobian(u).xreplace(op)
+    K = -km.forcing.xreplace(op).jacobian(q)
+    mck = list(M) + list(C) + list(K)
+    say("mck_s", "%.4g" % (time.perf_counter() - t0))
+    say("ops_mck_cse", ops_after_cse(mck, symbols))
+    say("ops_mck_q0_cse", ops_after_cse([e.subs({qi: 0 for qi in q}) for e in mck], symbols))
+    t0 = time.perf_counter()
     Ml, Al, _, _ = km.linearize(op_point=op, A_and_B=False, simplify=False)
     say("linearize_s", "%.4g" % (time.perf_counter() - t0))
-    say("ops_linear", ops(Ml) + ops(Al))
+    say("ops_linear", ops(Ml, symbols) + ops(Al, symbols))
     t0 = time.perf_counter()
-    replacements, reduced = sp.cse(list(Ml) + list(Al))
+    ops_cse = ops_after_cse(list(Ml) + list(Al), symbols)
     say("cse_s", "%.4g" % (time.perf_counter() - t0))
-    say("ops_linear_cse", sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced))
+    say("ops_linear_cse", ops_cse)
     if len(sys.argv) > 2:
         # Rows n..2n-1 of M_l [q'; u'] = A_l [q; u]: M u' = -K q - C u up to the sign SymPy gives
         # the dynamic rows (Fr + Fr* = 0 has -M): normalised by the sign of M_11.
