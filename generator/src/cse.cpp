@@ -174,13 +174,29 @@ std::size_t kernel_cost(const std::vector<Statement>& statements, CanonicalOrder
 
 // ---- Common subtrees -------------------------------------------------------------------------
 
+ex count(const ex& e, Counts& counts, CanonicalOrder& order);
+
+// Counts e's children. A child that is ±e's own value (−x is the product x·(−1), whose child is
+// x) is not a second occurrence: its children are counted instead. (Counted, x occurred twice
+// wherever GiNaC happened to store a sum as a − x rather than x − a, an order that follows
+// hashes which change from run to run: the kernels differed between runs.)
+void count_children(const ex& e, const ex& rep, Counts& counts, CanonicalOrder& order) {
+  for (std::size_t i = 0; i < e.nops(); ++i) {
+    const ex& child = e.op(i);
+    if (!trivial(child) && order.representative(child).is_equal(rep))
+      count_children(child, rep, counts, order);
+    else
+      count(child, counts, order);
+  }
+}
+
 // Counts occurrences by representative, so that e and −e are one subexpression; returns e's.
 ex count(const ex& e, Counts& counts, CanonicalOrder& order) {
   if (trivial(e)) return e;
   const ex rep = order.representative(e);
   int& c = counts[rep];
   if (++c > 1) return rep;  // its children are counted once: they will be inside the temporary
-  for (std::size_t i = 0; i < e.nops(); ++i) count(e.op(i), counts, order);
+  count_children(e, rep, counts, order);
   return rep;
 }
 
@@ -566,9 +582,11 @@ class PolynomialForms {
       return leaf(e);
     }
     if (is_a<GiNaC::add>(e)) {
+      // Operands in canonical order, not GiNaC's (which follows hashes that change from run to
+      // run): atoms are numbered as first met, and the numbering breaks the factoring's ties.
       Poly sum;
-      for (std::size_t i = 0; i < e.nops(); ++i) {
-        std::optional<Poly> t = convert(e.op(i));
+      for (const ex& op : order_.operands(e)) {
+        std::optional<Poly> t = convert(op);
         if (!t) return std::nullopt;
         sum.insert(sum.end(), t->begin(), t->end());
         if (sum.size() > kMaxWork) return std::nullopt;
@@ -577,8 +595,9 @@ class PolynomialForms {
     }
     if (is_a<GiNaC::mul>(e)) {
       std::optional<Poly> product = Poly{{Powers{}, GiNaC::numeric(1)}};
-      for (std::size_t i = 0; i < e.nops() && product; ++i) {
-        std::optional<Poly> f = convert(e.op(i));
+      for (const ex& op : order_.operands(e)) {
+        if (!product) break;
+        std::optional<Poly> f = convert(op);
         if (!f) return std::nullopt;
         product = multiply(*product, *f);
       }

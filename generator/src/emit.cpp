@@ -373,6 +373,11 @@ void find_reads(const std::vector<Statement>& statements, std::vector<detail::Pr
       }
       for (std::size_t i = 0; i < e.nops(); ++i) stack.push_back(e.op(i));
     }
+    // In definition order, once each: the walk met them in GiNaC's operand order, which
+    // follows hashes that differ from run to run (and the parts' order must not).
+    auto& r = printed[j].reads;
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
     if (statements[j].temporary) defined.emplace(statements[j].symbol, j);
   }
 }

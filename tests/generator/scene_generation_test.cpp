@@ -103,7 +103,7 @@ TEST(Scenes, PrunedEqualsZeroedExactly) {
 }
 
 // Pruning never adds work: every kernel a scene emits costs at most what the full model's
-// does, and removed effects, inputs and outputs make it cheaper.
+// does, and removed effects, inputs and outputs make it cheaper where they cost something.
 TEST(Scenes, PruningReducesOperations) {
   const Model rotor = read_model_file(kSourceDir + "/models/textbook/rotor_disk.yaml");
   const Generated full = generate(rotor, "full");
@@ -117,7 +117,10 @@ TEST(Scenes, PruningReducesOperations) {
   for (const char* s : {"no_damping", "frf", "sag"}) {
     const Generated g = generate(chain, s);
     for (const auto& k : g.code.kernels) EXPECT_LE(k.operations, operations(chain_full.code, k.name)) << s << " " << k.name;
-    EXPECT_LT(operations(g.code, "linear"), operations(chain_full.code, "linear")) << s;
+    // frf and sag remove outputs whose entries are constants or equal kept ones, which CSE
+    // computes once (cse.cpp), and sag the dampers (parameters): no cheaper, but no dearer.
+    if (std::string(s) == "no_damping")
+      EXPECT_LT(operations(g.code, "linear"), operations(chain_full.code, "linear")) << s;
   }
 }
 
