@@ -52,32 +52,35 @@ CanonicalOrder::CanonicalOrder(std::size_t memo_capacity) : capacity_(std::max<s
 
 void CanonicalOrder::set_sign(const ex& s, int sign) {
   if (!is_a<GiNaC::symbol>(s)) throw std::logic_error("mbsgen::CanonicalOrder::set_sign: not a symbol");
-  auto [it, inserted] = signs_.emplace(s, Signed{text(1, ex_to<GiNaC::symbol>(s).get_name()), sign});
-  if (!inserted && it->second.sign != sign)
-    throw std::logic_error("mbsgen::CanonicalOrder::set_sign: sign of " +
-                           ex_to<GiNaC::symbol>(s).get_name() + " already used");
+  if (const Signed* old = signs_.find(s)) {
+    if (old->sign != sign)
+      throw std::logic_error("mbsgen::CanonicalOrder::set_sign: sign of " +
+                             ex_to<GiNaC::symbol>(s).get_name() + " already used");
+    return;
+  }
+  signs_.insert(s, Signed{text(1, ex_to<GiNaC::symbol>(s).get_name()), sign});
 }
 
 void CanonicalOrder::remember(const ex& e, Signed r) {
   if (current_.size() >= capacity_) {
     // A new generation: what the last two did not use again is forgotten (a key computed again
     // is the same key).
-    previous_ = std::move(current_);
-    current_ = Memo();
+    previous_.swap(current_);
+    current_.clear();
   }
-  current_.emplace(e, r);
+  current_.insert(e, r);
 }
 
 CanonicalOrder::Signed CanonicalOrder::signed_key(const ex& e) {
   if (is_a<GiNaC::symbol>(e)) {
-    if (auto it = signs_.find(e); it != signs_.end()) return it->second;
+    if (const Signed* r = signs_.find(e)) return *r;
     return {text(1, ex_to<GiNaC::symbol>(e).get_name()), 1};
   }
-  if (auto it = current_.find(e); it != current_.end()) return it->second;
-  if (auto it = previous_.find(e); it != previous_.end()) {
-    const Signed r = it->second;
-    remember(e, r);
-    return r;
+  if (const Signed* r = current_.find(e)) return *r;
+  if (const Signed* r = previous_.find(e)) {
+    const Signed copy = *r;  // remember() may clear previous_
+    remember(e, copy);
+    return copy;
   }
   const Signed r = compute(e);
   remember(e, r);

@@ -17,14 +17,14 @@ using GiNaC::is_a;
 void Program::add_variable(const GiNaC::symbol& s) {
   if (!defs_.empty())
     throw std::logic_error("mbsgen::Program::add_variable: variables must precede definitions");
-  if (variable_index_.count(s)) return;
-  variable_index_.emplace(s, variables_.size());
+  if (variable_index_.find(s)) return;
+  variable_index_.insert(s, variables_.size());
   variables_.push_back(s);
 }
 
 long Program::index_of(const ex& symbol) const {
-  auto it = def_index_.find(symbol);
-  return it == def_index_.end() ? -1 : static_cast<long>(it->second);
+  const std::size_t* k = def_index_.find(symbol);
+  return k ? static_cast<long>(*k) : -1;
 }
 
 bool Program::bits_intersect(const Bits& a, const Bits& b) const {
@@ -41,11 +41,11 @@ Program::Bits Program::dependencies(const ex& e) const {
     ex x = stack.back();
     stack.pop_back();
     if (is_a<GiNaC::symbol>(x)) {
-      if (auto d = def_index_.find(x); d != def_index_.end()) {
-        const Bits& b = deps_[d->second];
+      if (const std::size_t* d = def_index_.find(x)) {
+        const Bits& b = deps_[*d];
         for (std::size_t i = 0; i < bits.size(); ++i) bits[i] |= b[i];
-      } else if (auto v = variable_index_.find(x); v != variable_index_.end()) {
-        bits[v->second / 64] |= std::uint64_t{1} << (v->second % 64);
+      } else if (const std::size_t* v = variable_index_.find(x)) {
+        bits[*v / 64] |= std::uint64_t{1} << (*v % 64);
       }
       continue;
     }
@@ -60,7 +60,7 @@ void Program::collect_intermediates(const ex& e, std::vector<std::size_t>& out) 
     ex x = stack.back();
     stack.pop_back();
     if (is_a<GiNaC::symbol>(x)) {
-      if (auto d = def_index_.find(x); d != def_index_.end()) out.push_back(d->second);
+      if (const std::size_t* d = def_index_.find(x)) out.push_back(*d);
       continue;
     }
     for (std::size_t i = 0; i < x.nops(); ++i) stack.push_back(x.op(i));
@@ -103,7 +103,7 @@ ex Program::intern_functions(const ex& e) {
   if (is_a<GiNaC::symbol>(e) || is_a<GiNaC::numeric>(e)) return e;
   const bool named = internable(e);
   if (!named && e.nops() == 0) return e;
-  if (auto it = interned_.find(e); it != interned_.end()) return it->second;
+  if (const ex* r = interned_.find(e)) return *r;
   struct InternChildren : GiNaC::map_function {
     Program* self;
     explicit InternChildren(Program* p) : self(p) {}
@@ -115,7 +115,7 @@ ex Program::intern_functions(const ex& e) {
   ex mapped = e.nops() > 0 ? e.map(intern_children) : e;
   ex result = mapped;
   if (named) result = define_node(mapped);
-  interned_.emplace(e, result);
+  if (!interned_.find(e)) interned_.insert(e, result);
   return result;
 }
 
@@ -128,10 +128,11 @@ ex Program::define(const ex& e0) {
 
 ex Program::define_node(const ex& e) {
   if (trivial(e)) return e;
-  if (auto it = interned_.find(e); it != interned_.end() && is_a<GiNaC::symbol>(it->second))
-    return it->second;
+  const ex* known = interned_.find(e);
+  if (known && is_a<GiNaC::symbol>(*known)) return *known;
+  const bool recorded = known != nullptr;
   const ex t = add_definition(e);
-  interned_.emplace(e, t);
+  if (!recorded) interned_.insert(e, t);  // (an entry already there is kept, as emplace did)
   return t;
 }
 
@@ -140,8 +141,7 @@ ex Program::define_plain(const ex& e) {
   // The form interning gave an expression with functions has its symbol; an expression without
   // any is named anew (intern_functions records it as itself, not as a symbol), and CSE merges
   // equal temporaries when a kernel is emitted.
-  if (auto it = interned_.find(e); it != interned_.end() && is_a<GiNaC::symbol>(it->second))
-    return it->second;
+  if (const ex* known = interned_.find(e); known && is_a<GiNaC::symbol>(*known)) return *known;
   return add_definition(e);
 }
 
@@ -150,16 +150,16 @@ ex Program::add_definition(const ex& e) {
   order_.set_sign(t, order_.sign(e));
   deps_.push_back(dependencies(e));
   defs_.push_back({t, e});
-  def_index_.emplace(t, defs_.size() - 1);
+  def_index_.insert(t, defs_.size() - 1);
   return t;
 }
 
 std::size_t Program::variable(const GiNaC::symbol& x, const char* caller) const {
-  auto v = variable_index_.find(x);
-  if (v == variable_index_.end())
+  const std::size_t* v = variable_index_.find(x);
+  if (!v)
     throw std::logic_error(std::string("mbsgen::Program::") + caller +
                            ": not a registered variable: " + x.get_name());
-  return v->second;
+  return *v;
 }
 
 bool Program::depends_on(const ex& e, const GiNaC::symbol& x) {
@@ -246,7 +246,7 @@ void Program::collect_symbols(const ex& e, const GiNaC::symbol& x, std::vector<s
     ex y = stack.back();
     stack.pop_back();
     if (is_a<GiNaC::symbol>(y)) {
-      if (auto d = def_index_.find(y); d != def_index_.end()) out.push_back(d->second);
+      if (const std::size_t* d = def_index_.find(y)) out.push_back(*d);
       else if (y.is_equal(x)) has_x = true;
       continue;
     }
@@ -261,7 +261,7 @@ ex Program::diff(const ex& e, const GiNaC::symbol& x) {
   if (is_a<GiNaC::numeric>(e)) return 0;
   if (is_a<GiNaC::symbol>(e)) {
     if (e.is_equal(x)) return 1;
-    if (auto d = def_index_.find(e); d != def_index_.end()) return diff_intermediate(d->second, var);
+    if (const std::size_t* d = def_index_.find(e)) return diff_intermediate(*d, var);
     return 0;
   }
   std::vector<std::size_t> ts;
@@ -291,10 +291,9 @@ ex Program::substitute(const ex& e, Substitution& s) {
   if (s.mask_.empty()) {
     s.mask_.assign((variables_.size() + 63) / 64, 0);
     for (const auto& [key, value] : s.values_) {
-      auto v = variable_index_.find(key);
-      if (v == variable_index_.end())
-        throw std::logic_error("mbsgen::Program::substitute: not a registered variable");
-      s.mask_[v->second / 64] |= std::uint64_t{1} << (v->second % 64);
+      const std::size_t* v = variable_index_.find(key);
+      if (!v) throw std::logic_error("mbsgen::Program::substitute: not a registered variable");
+      s.mask_[*v / 64] |= std::uint64_t{1} << (*v % 64);
     }
   }
   std::vector<std::size_t> ts;

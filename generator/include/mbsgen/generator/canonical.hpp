@@ -11,12 +11,13 @@
 // stores canonical values, so a temporary t defined as −canonical(v) is printed as −t.
 #pragma once
 
+#include "mbsgen/generator/ex_table.hpp"
+
 #include <ginac/ginac.h>
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 namespace mbsgen {
@@ -60,13 +61,12 @@ class CanonicalOrder {
   std::size_t signed_symbols() const { return signs_.size(); }
 
  private:
-  using Memo = std::unordered_map<GiNaC::ex, Signed, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
   Signed compute(const GiNaC::ex& e);
   void remember(const GiNaC::ex& e, Signed r);
 
   std::size_t capacity_;
-  Memo signs_;              // symbols declared by set_sign
-  Memo current_, previous_;  // compound expressions and numbers, two generations
+  ExTable<Signed> signs_;              // symbols declared by set_sign
+  ExTable<Signed> current_, previous_;  // compound expressions and numbers, two generations
 };
 
 /// Odd (f(−x) = −f(x)) and even (f(−x) = f(x)) functions of one argument, by GiNaC name.

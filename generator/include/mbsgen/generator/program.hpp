@@ -8,6 +8,7 @@
 #pragma once
 
 #include "mbsgen/generator/canonical.hpp"
+#include "mbsgen/generator/ex_table.hpp"
 
 #include <ginac/ginac.h>
 
@@ -84,11 +85,11 @@ class Program {
   bool bits_intersect(const Bits& a, const Bits& b) const;
 
   std::vector<GiNaC::symbol> variables_;
-  std::unordered_map<GiNaC::ex, std::size_t, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> variable_index_;
+  ExTable<std::size_t> variable_index_;
   std::vector<Definition> defs_;
   std::vector<Bits> deps_;
-  std::unordered_map<GiNaC::ex, std::size_t, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> def_index_;
-  std::unordered_map<GiNaC::ex, GiNaC::ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> interned_;
+  ExTable<std::size_t> def_index_;
+  ExTable<GiNaC::ex> interned_;
   CanonicalOrder order_;  // intermediates are numbered in this order, not in GiNaC's
   std::unordered_map<std::uint64_t, GiNaC::ex> diff_memo_;
   std::unordered_map<std::size_t, GiNaC::ex> inline_memo_;
