@@ -16,10 +16,6 @@ using GiNaC::is_a;
 
 namespace {
 
-// Whether CppPrinter (emit.cpp) writes a sum led by a positive term ("b - a" for −(a − b));
-// today it leads with the canonically first term and negates the whole when that is negative.
-constexpr bool kPrinterLeadsWithPositive = false;
-
 bool trivial(const ex& e) {
   if (is_a<GiNaC::symbol>(e) || is_a<GiNaC::numeric>(e) || is_a<GiNaC::constant>(e)) return true;
   return is_a<GiNaC::mul>(e) && e.nops() == 2 && is_a<GiNaC::numeric>(e.op(1)) && is_a<GiNaC::symbol>(e.op(0));
@@ -30,28 +26,9 @@ bool integer_power(const ex& e) {
 }
 
 // The sign CppPrinter (emit.cpp) writes e with: −1 when it writes −e (a negation wherever that
-// cannot go into a sum or product around it). Today that is e's canonical sign. Were sums led by
-// a positive term, only a sum of negative terms would be negative; a product has its factors'
-// signs; a symbol its canonical sign (its variable holds the canonical value, canonical.hpp).
-int printed_sign(const ex& e, CanonicalOrder& order) {
-  if (!kPrinterLeadsWithPositive) return order.sign(e);
-  if (is_a<GiNaC::numeric>(e)) return ex_to<GiNaC::numeric>(e).is_negative() ? -1 : 1;
-  if (is_a<GiNaC::symbol>(e)) return order.sign(e);
-  if (is_a<GiNaC::add>(e)) {
-    for (std::size_t i = 0; i < e.nops(); ++i)
-      if (printed_sign(e.op(i), order) > 0) return 1;
-    return e.nops() > 0 ? -1 : 1;
-  }
-  if (is_a<GiNaC::mul>(e)) {
-    int sign = 1;
-    for (std::size_t i = 0; i < e.nops(); ++i) sign *= printed_sign(e.op(i), order);
-    return sign;
-  }
-  if (integer_power(e)) return ex_to<GiNaC::numeric>(e.op(1)).is_odd() ? printed_sign(e.op(0), order) : 1;
-  if (is_a<GiNaC::function>(e) && e.nops() == 1 && odd_function(ex_to<GiNaC::function>(e).get_name()))
-    return printed_sign(e.op(0), order);
-  return 1;
-}
+// cannot go into a sum or product around it). That is e's canonical sign: the printer leads a
+// sum with its canonically first term and negates the whole when that term is negative.
+int printed_sign(const ex& e, CanonicalOrder& order) { return order.sign(e); }
 
 using ExMap = std::unordered_map<ex, ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
 using Counts = std::unordered_map<ex, int, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
