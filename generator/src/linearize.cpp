@@ -1,6 +1,6 @@
 #include "mbsgen/generator/linearize.hpp"
 
-#include "point_evaluator.hpp"
+#include "sample_points.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -20,12 +20,13 @@ struct Structure {
 // arguments (y0, ẏ0, p), or, with at_operating_point, of the parameters p with (y0, ẏ0) the
 // operating point (y0 free for an equilibrium, which Newton's method finds). They are evaluated
 // at two pseudo-random points with 50 digits and called zero when every entry is below 1e-35 of
-// the matrix's largest entry at both points. A nonzero analytic function vanishes only on a set
+// the largest entry of Q and K at both points. A nonzero analytic function vanishes only on a set
 // of measure zero, and 15 digits of margin cover the cancellation in the sums, so the test errs
 // in neither direction in practice; a point where the evaluation fails (a pole) gives
 // "nonzero", the safe answer. A numerical "zero" is then proved symbolically entry by entry
 // (structural_zeros.hpp), so that a part 1e-40 of the rest is not taken for zero.
-Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operating_point) {
+Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operating_point,
+                       detail::SamplePoints& points) {
   const std::size_t f = lin.Q.size();
   // Only entries that are not exact zeros are evaluated (a large model's matrices are mostly
   // zeros: evaluating all f^2 of them dominated mbsgen check of 2,000 oscillators).
@@ -43,23 +44,24 @@ Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operat
   Structure s{true, true, true};
   const long digits = GiNaC::Digits;
   GiNaC::Digits = detail::PointEvaluator::kDigits;
-  std::uint64_t state = 0x2545f4914f6cdd1dULL;
   try {
-    for (int point = 0; point < 2; ++point) {
-      const GiNaC::exmap values = detail::sample_point(eq, lin, state, at_operating_point);
-      const std::vector<GiNaC::numeric> v = detail::PointEvaluator(eq.program, values).evaluate(entries);
+    for (std::size_t point = 0; point < 2; ++point) {
+      const std::vector<GiNaC::numeric> v = points.evaluate(detail::kSampleSeed, at_operating_point, point, entries);
       const GiNaC::numeric zero = 0;
       auto at = [&](std::size_t matrix, std::size_t i, std::size_t j) -> const GiNaC::numeric& {
         const std::size_t k = slot[matrix * f * f + i * f + j];
         return k == SIZE_MAX ? zero : v[k];
       };
+      // One scale for Q and K: Q of an undamped model at rest vanishes as a whole, and a
+      // tolerance relative to its largest entry, rounding noise, decided by the luck of the rounding.
+      GiNaC::numeric scale = 0;
+      for (const GiNaC::numeric& x : v) scale = std::max(scale, GiNaC::abs(x));
       for (std::size_t matrix = 0; matrix < 2; ++matrix) {
-        GiNaC::numeric scale = 0, sym = 0, skew = 0;
+        GiNaC::numeric sym = 0, skew = 0;
         for (std::size_t i = 0; i < f; ++i)
           for (std::size_t j = 0; j < f; ++j) {
             if (slot[matrix * f * f + i * f + j] == SIZE_MAX && slot[matrix * f * f + j * f + i] == SIZE_MAX)
               continue;  // both exact zeros: no contribution
-            scale = std::max(scale, GiNaC::abs(at(matrix, i, j)));
             sym = std::max(sym, GiNaC::abs(at(matrix, i, j) + at(matrix, j, i)));
             skew = std::max(skew, GiNaC::abs(at(matrix, i, j) - at(matrix, j, i)));
           }
@@ -211,10 +213,12 @@ LinearEquations linearize(Equations& eq) {
   // Identically vanishing parts are written as exact zeros, and the matching symmetry of Q and
   // K is made exact: each pair of entries is then computed once, and the kernels return exactly
   // symmetric (or skew) matrices.
-  const Structure st = structure_of(eq, lin, false);
+  // The screen of the structural zeros evaluates the program at the same points.
+  detail::SamplePoints points(eq, lin);
+  const Structure st = structure_of(eq, lin, false, points);
   Structure op_structure = st;
   if (!(st.D_zero && st.G_zero && st.N_zero)) {
-    const Structure s = structure_of(eq, lin, true);
+    const Structure s = structure_of(eq, lin, true, points);
     op_structure = {st.D_zero || s.D_zero, st.G_zero || s.G_zero, st.N_zero || s.N_zero};
   }
   lin.D_zero = op_structure.D_zero;
@@ -235,7 +239,7 @@ LinearEquations linearize(Equations& eq) {
     }
   split(lin.Q, lin.D, lin.G);
   split(lin.K, lin.Ks, lin.N);
-  lin.zeros = find_structural_zeros(eq, lin);
+  lin.zeros = detail::find_structural_zeros(eq, lin, points);
   return lin;
 }
 

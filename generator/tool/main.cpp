@@ -178,13 +178,14 @@ int main(int argc, char** argv) try {
     mbsgen::Model model = mbsgen::read_model_file(model_file);
     const mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
     progress.stage("deriving the equations");
-    mbsgen::Equations eq = mbsgen::derive(pruned);
+    mbsgen::Equations& eq = mbsgen::tool::kept_until_exit<mbsgen::Equations>([&] { return mbsgen::derive(pruned); });
     for (const auto& [e, why] : eq.loops.dropped)
       if (eq.loops.redundant && why.rfind("redundant", 0) == 0)
         std::cerr << "mbsgen: warning: constraint '" << e.constraint << "'"
                   << (e.component.empty() ? "" : " (" + e.component + ")") << " dropped: " << why << "\n";
     progress.stage("linearizing");
-    mbsgen::LinearEquations lin = mbsgen::linearize(eq);
+    mbsgen::LinearEquations& lin =
+        mbsgen::tool::kept_until_exit<mbsgen::LinearEquations>([&] { return mbsgen::linearize(eq); });
     progress.stage("checking the operating point");
     mbsgen::check_operating_point(eq, lin);
     progress.stage("emitting the kernels");

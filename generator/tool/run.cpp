@@ -280,9 +280,9 @@ bool build_solver(const std::string& model_file, const std::string& scene, const
   const Model full = read_model_file(model_file);
   const Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
   progress.stage("deriving the equations");
-  Equations eq = derive(model);
+  Equations& eq = kept_until_exit<Equations>([&] { return derive(model); });
   progress.stage("linearizing");
-  LinearEquations lin = linearize(eq);
+  LinearEquations& lin = kept_until_exit<LinearEquations>([&] { return linearize(eq); });
   progress.stage("checking the operating point");
   check_operating_point(eq, lin);
   progress.stage("emitting the kernels");
