@@ -31,7 +31,9 @@ bool integer_power(const ex& e) {
 int printed_sign(const ex& e, CanonicalOrder& order) { return order.sign(e); }
 
 using ExMap = std::unordered_map<ex, ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
-using Counts = std::unordered_map<ex, int, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
+// Looked up for every node of every statement: open addressing (ex_table.hpp).
+using Counts = ExTable<int>;
+using ExTableMap = ExTable<ex>;
 using Index = std::unordered_map<ex, std::size_t, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
 
 // Puts replacements (symbol → expression) into expressions: a hash lookup per symbol and a memo
@@ -180,9 +182,9 @@ ex count(const ex& e, Counts& counts, CanonicalOrder& order) {
 struct Rewriter : GiNaC::map_function {
   const Counts& counts;
   CanonicalOrder& order;
-  ExMap replaced;  // representative -> ±the temporary that holds it
-  ExMap visited;   // expression -> rewritten expression
-  ExMap aliases;   // dropped temporary -> ±the temporary that holds its value
+  ExTableMap replaced;  // representative -> ±the temporary that holds it
+  ExTableMap visited;   // expression -> rewritten expression
+  ExTableMap aliases;   // dropped temporary -> ±the temporary that holds its value
   std::vector<Statement>* out = nullptr;
   int next = 0;
 
@@ -199,8 +201,8 @@ struct Rewriter : GiNaC::map_function {
   ex alias(const ex& e) const {
     if (aliases.empty()) return e;
     if (is_a<GiNaC::symbol>(e)) {
-      const auto it = aliases.find(e);
-      return it == aliases.end() ? e : it->second;
+      const ex* a = aliases.find(e);
+      return a ? *a : e;
     }
     if (is_a<GiNaC::mul>(e)) return alias(e.op(0)) * alias(e.op(1));
     return e;
@@ -208,13 +210,13 @@ struct Rewriter : GiNaC::map_function {
 
   ex operator()(const ex& e) override {
     if (trivial(e)) return alias(e);
-    if (auto it = visited.find(e); it != visited.end()) return it->second;
+    if (const ex* v = visited.find(e)) return *v;
     const int sign = order.sign(e);
     const ex rep = sign > 0 ? e : ex(-e);
     ex result;
-    if (auto it = replaced.find(rep); it != replaced.end()) {
-      result = sign * it->second;
-    } else if (auto c = counts.find(rep); c != counts.end() && c->second > 1) {
+    if (const ex* r = replaced.find(rep)) {
+      result = sign * *r;
+    } else if (const int* c = counts.find(rep); c && *c > 1) {
       // −e is usually e with its sign absorbed (a sum's terms, a product's coefficient); an odd
       // power of a negative-signed base, e.g. t^-1, stays the product (t^-1)·(−1), whose child
       // is e itself: map e's children instead of recursing into e forever.
@@ -278,12 +280,12 @@ std::vector<Statement> share_subtrees(const std::vector<Statement>& in, Canonica
     }
     const int sign = order.sign(s.value);
     const ex& rep = reps[j];
-    const bool repeated = counts.at(rep) > 1;
-    if (auto it = repeated ? rewrite.replaced.find(rep) : rewrite.replaced.end(); it != rewrite.replaced.end()) {
+    const bool repeated = *counts.find(rep) > 1;
+    if (const ex* r = repeated ? rewrite.replaced.find(rep) : nullptr) {
       if (s.temporary) {
-        rewrite.aliases.emplace(s.symbol, sign * it->second);
+        rewrite.aliases.emplace(s.symbol, sign * *r);
       } else {
-        out.push_back({s.target, sign * it->second, false, s.symbol});
+        out.push_back({s.target, sign * *r, false, s.symbol});
       }
       continue;
     }

@@ -38,7 +38,20 @@ class ExTable {
     ++size_;
   }
 
+  /// Stores v for e unless e is present (as std::unordered_map::emplace); true when stored.
+  bool emplace(const GiNaC::ex& e, V v) {
+    if (find(e)) return false;
+    insert(e, std::move(v));
+    return true;
+  }
+  /// The value stored for e, stored as V{} first when e is absent.
+  V& operator[](const GiNaC::ex& e) {
+    if (V* v = find(e)) return *v;
+    insert(e, V{});
+    return *find(e);
+  }
   std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
 
   /// Forgets every entry (and releases the expressions), keeping the slots.
   void clear() {
