@@ -3,6 +3,7 @@
 #pragma once
 
 #include "checked_subs.hpp"
+#include "mbsgen/generator/ex_table.hpp"
 #include "mbsgen/generator/linearize.hpp"
 #include "mbsgen/generator/program.hpp"
 
@@ -10,7 +11,6 @@
 #include <cstdint>
 
 #include <stdexcept>
-#include <unordered_map>
 #include <vector>
 
 namespace mbsgen::detail {
@@ -37,7 +37,7 @@ class PointEvaluator {
       stack.pop_back();
       if (GiNaC::is_a<GiNaC::symbol>(e)) {
         const long i = prog_.index_of(e);
-        if (i >= 0 && !needed[static_cast<std::size_t>(i)] && !values_.count(e)) {
+        if (i >= 0 && !needed[static_cast<std::size_t>(i)] && !values_.find(e)) {
           needed[static_cast<std::size_t>(i)] = 1;
           stack.push_back(defs[static_cast<std::size_t>(i)].value);
         }
@@ -65,9 +65,9 @@ class PointEvaluator {
     using GiNaC::is_a;
     if (is_a<GiNaC::numeric>(e)) return GiNaC::ex_to<GiNaC::numeric>(e);
     if (is_a<GiNaC::symbol>(e)) {
-      auto it = values_.find(e);
-      if (it == values_.end()) throw std::runtime_error("unbound symbol");
-      return it->second;
+      const GiNaC::numeric* v = values_.find(e);
+      if (!v) throw std::runtime_error("unbound symbol");
+      return *v;
     }
     if (is_a<GiNaC::add>(e)) {
       GiNaC::numeric sum = 0;
@@ -96,7 +96,7 @@ class PointEvaluator {
   }
 
   const Program& prog_;
-  std::unordered_map<ex, GiNaC::numeric, std::hash<ex>, GiNaC::ex_is_equal> values_;
+  ExTable<GiNaC::numeric> values_;  // looked up once per symbol of every definition evaluated
 };
 
 /// A pseudo-random point for the structure tests of the linear matrices (linearize.cpp,
