@@ -30,10 +30,9 @@ bool integer_power(const ex& e) {
 // sum with its canonically first term and negates the whole when that term is negative.
 int printed_sign(const ex& e, CanonicalOrder& order) { return order.sign(e); }
 
-using ExMap = std::unordered_map<ex, ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
 // Looked up for every node of every statement: open addressing (ex_table.hpp).
+using ExMap = ExTable<ex>;
 using Counts = ExTable<int>;
-using ExTableMap = ExTable<ex>;
 using Index = std::unordered_map<ex, std::size_t, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
 
 // Puts replacements (symbol → expression) into expressions: a hash lookup per symbol and a memo
@@ -45,11 +44,11 @@ struct Replace : GiNaC::map_function {
   ExMap memo;
   ex operator()(const ex& e) override {
     if (is_a<GiNaC::symbol>(e)) {
-      const auto it = replaced.find(e);
-      return it == replaced.end() ? e : it->second;
+      const ex* r = replaced.find(e);
+      return r ? *r : e;
     }
     if (e.nops() == 0 || replaced.empty()) return e;
-    if (auto it = memo.find(e); it != memo.end()) return it->second;
+    if (const ex* m = memo.find(e)) return *m;
     const ex r = e.map(*this);
     memo.emplace(e, r);
     return r;
@@ -182,9 +181,9 @@ ex count(const ex& e, Counts& counts, CanonicalOrder& order) {
 struct Rewriter : GiNaC::map_function {
   const Counts& counts;
   CanonicalOrder& order;
-  ExTableMap replaced;  // representative -> ±the temporary that holds it
-  ExTableMap visited;   // expression -> rewritten expression
-  ExTableMap aliases;   // dropped temporary -> ±the temporary that holds its value
+  ExMap replaced;  // representative -> ±the temporary that holds it
+  ExMap visited;   // expression -> rewritten expression
+  ExMap aliases;   // dropped temporary -> ±the temporary that holds its value
   std::vector<Statement>* out = nullptr;
   int next = 0;
 
@@ -327,8 +326,8 @@ std::vector<Statement> merge_equal_temporaries(const std::vector<Statement>& in,
     if (s.temporary && !trivial(v)) {
       const int sign = order.sign(v);
       const ex rep = sign > 0 ? v : ex(-v);
-      if (auto it = first.find(rep); it != first.end()) {
-        replace.replaced[s.symbol] = sign * it->second;
+      if (const ex* f = first.find(rep)) {
+        replace.replaced[s.symbol] = sign * *f;
         continue;
       }
       first.emplace(rep, sign * s.symbol);

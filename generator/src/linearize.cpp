@@ -46,7 +46,7 @@ Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operat
   GiNaC::Digits = detail::PointEvaluator::kDigits;
   try {
     for (std::size_t point = 0; point < 2; ++point) {
-      const std::vector<GiNaC::numeric> v = points.evaluate(detail::kSampleSeed, at_operating_point, point, entries);
+      const std::vector<GiNaC::numeric> v = points.evaluate(at_operating_point, point, entries);
       const GiNaC::numeric zero = 0;
       auto at = [&](std::size_t matrix, std::size_t i, std::size_t j) -> const GiNaC::numeric& {
         const std::size_t k = slot[matrix * f * f + i * f + j];

@@ -61,7 +61,7 @@ std::vector<ZeroPattern> screen(LinearEquations& lin, StructuralZeros& z, bool a
     for (std::size_t point = 0; point < 2; ++point) {
       // (Called with at_operating_point only for a given operating point.) The points of the
       // symmetry test (linearize.cpp), whose values are kept.
-      const std::vector<GiNaC::numeric> v = points.evaluate(detail::kSampleSeed, at_operating_point, point, entries);
+      const std::vector<GiNaC::numeric> v = points.evaluate(at_operating_point, point, entries);
       // One scale for all matrices: a matrix that vanishes as a whole at the point (N = skew K of
       // a conservative model at rest) has only rounding noise for its largest entry, and a
       // tolerance relative to that noise found its zeros by the luck of the rounding.
