@@ -290,7 +290,12 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
   const std::size_t nb = kin.bodies.size();
 
   switch (options.projection) {
-    case Projection::composite: {
+    case Projection::composite:
+    case Projection::link_frames: {
+      if (options.projection == Projection::composite && !prefers_link_frames(model)) {
+        project_composite(eq, body_wrenches(model, eq));
+        break;
+      }
       LinkFrameProjection link = project_link_frames(model, prog, eq.y, eq.yd);
       eq.M = std::move(link.M);
       eq.residual = std::move(link.residual);

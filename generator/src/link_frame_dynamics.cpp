@@ -45,7 +45,7 @@ Spatial force_to_parent(const Step& step, const Spatial& f) {
   return {mul(step.R, f.w), mul(step.R, f.v)};
 }
 
-// Symmetric J' = R J Rᵀ for an elementary R about axis k: 20 operations.
+// Symmetric J' = R J Rᵀ for an elementary R about axis k: 27 operations for a full J.
 Mat3 rotate_elementary(Program& prog, const Mat3& J, const Mat3& R, int k) {
   const int i = (k + 1) % 3, j = (k + 2) % 3;
   const ex c = R[i][i], s = R[j][i];
@@ -57,7 +57,11 @@ Mat3 rotate_elementary(Program& prog, const Mat3& J, const Mat3& R, int k) {
   const ex Bij = prog.define(c * J[i][j] - s * J[j][j]);
   Jp[i][i] = prog.define(c * Bii - s * Bij);
   Jp[i][j] = Jp[j][i] = prog.define(s * Bii + c * Bij);
-  Jp[j][j] = prog.define(J[i][i] + J[j][j] - Jp[i][i]);  // the trace is invariant
+  // Not J_ii + J_jj − J'_ii (the trace is invariant): that loses J'_jj ≪ J_ii to rounding, even at
+  // θ = 0, where this form is exact.
+  const ex Bji = prog.define(s * J[i][i] + c * J[j][i]);
+  const ex Bjj = prog.define(s * J[i][j] + c * J[j][j]);
+  Jp[j][j] = prog.define(s * Bji + c * Bjj);
   return Jp;
 }
 
@@ -117,7 +121,7 @@ SpatialInertia body_inertia(Program& prog, const Body& body) {
   for (int a = 0; a < 3; ++a)
     for (int b = a; b < 3; ++b)
       I.J[a][b] = I.J[b][a] =
-          prog.define(body.inertia[a][b] + (a == b ? body.mass * c2 : ex(0)) - I.h[a] * c[b]);
+          prog.define(body.inertia[a][b] + body.mass * ((a == b ? c2 : ex(0)) - c[a] * c[b]));
   return I;
 }
 
@@ -251,7 +255,10 @@ ExMatrix crba(Program& prog, const std::vector<Step>& steps, const std::vector<S
       for (std::size_t n = B;;) {
         const int p = steps[n].parent;
         if (p < 0 || !columns_above[static_cast<std::size_t>(p)]) break;
-        F = define(prog, force_to_parent(steps[n], F));
+        // Not named after a translation, so that s_aᵀ F shows its terms: a coordinate in two
+        // steps' angles (an absolute angle θ₂ − θ₁) then cancels exactly in the sum of M_jk.
+        F = force_to_parent(steps[n], F);
+        if (!steps[n].translation) F = define(prog, F);
         n = static_cast<std::size_t>(p);
         for (const auto& [j, s] : steps[n].columns) {
           const ex x = dot(s, F);
@@ -267,6 +274,21 @@ ExMatrix crba(Program& prog, const std::vector<Step>& steps, const std::vector<S
 }
 
 }  // namespace
+
+bool prefers_link_frames(const Model& model) {
+  if (!model.velocity_constraints().empty()) return false;
+  for (const auto& c : model.constraints())
+    if (c.kind == ConstraintKind::rolling) return false;
+  int axis = -1;
+  for (const auto& body : model.bodies()) {
+    if (body.rotation_matrix) return true;
+    for (const auto& rot : body.rotations) {
+      if (axis >= 0 && axis != static_cast<int>(rot.axis)) return true;
+      axis = static_cast<int>(rot.axis);
+    }
+  }
+  return false;
+}
 
 LinkFrameProjection project_link_frames(const Model& model, Program& prog,
                                         const std::vector<GiNaC::symbol>& y,

@@ -34,6 +34,19 @@ struct LinkFrameProjection {
   std::vector<GiNaC::ex> residual;  ///< inertial and gravity part of k(y, ẏ) − q(y, ẏ), length f
 };
 
+/// Whether derive() takes this projection for `model` (Projection::composite): yes unless
+///  - the model is planar in the sense that every rotation is elementary about one common axis
+///    (or there are none): world axes are then already 2-D and the link frames only add the
+///    rotation of gravity into every link (the planar chain's linear kernel: 33 operations
+///    against 31 at N = 2, and SymPy's 31 is a test's bound);
+///  - the model has nonholonomic constraints (rolling, velocity constraints): the exact zeros of
+///    its descriptor model are proved on written-out expressions, which the nesting of link
+///    frames makes larger than the proof's budget (rolling disk: 3 zeros everywhere lost; the
+///    Whipple bicycle's reduced Q₀₀, unproved either way, came out as rounding noise instead of
+///    0, and Table 2's eigenvalues moved by 1e-11).
+/// Such models take the world-frame route (Projection::world_composite) as a whole.
+bool prefers_link_frames(const Model& model);
+
 /// M and the inertial + gravity residual of `model` (validated), as intermediates of `program`
 /// whose variables the caller registered. y, yd: the model's coordinates and rates (length f).
 /// The velocity-quadratic terms are left out when model.inertial_velocity_terms() is false.
