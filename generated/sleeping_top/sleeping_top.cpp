@@ -75,14 +75,11 @@ extern "C" int sleeping_top_residual(const double* y, const double* yd, const do
   const double t1 = std::sin(y[0]);
   const double t2 = std::cos(y[1]);
   const double t3 = std::sin(y[1]);
-  const double t107 = p[3]*yd[0]*t2*yd[1];
   const double c0 = (p[1]*p[1])*p[0] - p[3] + p[2];
   const double c1 = p[3]*yd[2];
-  const double t112 = t0*p[0]*p[1]*t3*p[4] - yd[0]*(yd[0]*t3*c0 - c1)*t2;
-  const double t115 = (p[0]*p[1]*t1*p[4] + yd[1]*(yd[0]*2.0*t3*c0 - c1))*t2;
-  r[0] = -t115;
-  r[1] = -t112;
-  r[2] = t107;
+  r[0] = -(p[0]*p[1]*t1*p[4] + yd[1]*(yd[0]*2.0*t3*c0 - c1))*t2;
+  r[1] = -(t0*p[0]*p[1]*t3*p[4] - yd[0]*(yd[0]*t3*c0 - c1)*t2);
+  r[2] = p[3]*yd[0]*t2*yd[1];
   int status = 0;
   if (!all_finite(r, 3)) status = 1;
   return status;
@@ -239,8 +236,8 @@ extern "C" int sleeping_top_outputs(const double* y, const double* yd, const dou
   (void)yd;
   (void)p;
   const double t3 = std::sin(y[1]);
-  const double t119 = 2.0*p[1]*t3;
-  z[0] = t119;
+  const double t116 = 2.0*p[1]*t3;
+  z[0] = t116;
   int status = 0;
   if (!all_finite(z, 1)) status = 1;
   return status;

@@ -66,8 +66,9 @@ extern "C" int spherical_pendulum_conical_residual(const double* y, const double
   (void)p;
   const double t2 = std::cos(y[0]);
   const double t3 = std::sin(y[0]);
+  const double t58 = p[0]*2.0*yd[0]*t3*(p[1]*p[1])*t2*yd[1];
   r[0] = -p[1]*p[0]*(p[1]*(yd[1]*yd[1])*t2 - p[2])*t3;
-  r[1] = p[0]*2.0*yd[0]*t3*(p[1]*p[1])*t2*yd[1];
+  r[1] = t58;
   int status = 0;
   if (!all_finite(r, 2)) status = 1;
   return status;
@@ -81,11 +82,11 @@ extern "C" int spherical_pendulum_conical_linear(const double* y0, const double*
   (void)p;
   const double t2 = std::cos(y0[0]);
   const double t3 = std::sin(y0[0]);
-  const double t85 = std::sqrt(3.0);
-  const double t86 = std::sqrt(t85*p[2]/p[1]);
-  const double t87 = std::sqrt(0.66666666666666663);
-  const double t99 = 0.16666666666666666*3.1415926535897931;
-  const double t100 = t87*t86;
+  const double t105 = std::sqrt(3.0);
+  const double t106 = std::sqrt(t105*p[2]/p[1]);
+  const double t107 = std::sqrt(0.66666666666666663);
+  const double t127 = 0.16666666666666666*3.1415926535897931;
+  const double t128 = t107*t106;
   const double c0 = (p[1]*p[1]);
   M[0] = p[0]*c0;
   M[1] = 0.0;
@@ -110,10 +111,10 @@ extern "C" int spherical_pendulum_conical_linear(const double* y0, const double*
   Cv[1] = 0.0;
   Cv[2] = 0.0;
   Cv[3] = 0.0;
-  const double op0 = t99;
+  const double op0 = t127;
   const double op1 = 0.0;
   const double op2 = 0.0;
-  const double op3 = t100;
+  const double op3 = t128;
   // Exact zeros at the operating point (zero there for every parameter value).
   if (at_operating_point(y0[0], op0) && at_operating_point(y0[1], op1) && at_operating_point(yd0[0], op2) && at_operating_point(yd0[1], op3)) {
     Q[3] = 0.0;
@@ -134,15 +135,15 @@ extern "C" int spherical_pendulum_conical_linear_structured(const double* y0, co
   (void)y0;
   (void)yd0;
   (void)p;
-  const double t85 = std::sqrt(3.0);
-  const double t86 = std::sqrt(t85*p[2]/p[1]);
-  const double t87 = std::sqrt(0.66666666666666663);
-  const double t100 = t87*t86;
-  const double t101 = 0.16666666666666666*3.1415926535897931;
-  const double op0 = t101;
+  const double t105 = std::sqrt(3.0);
+  const double t106 = std::sqrt(t105*p[2]/p[1]);
+  const double t107 = std::sqrt(0.66666666666666663);
+  const double t128 = t107*t106;
+  const double t129 = 0.16666666666666666*3.1415926535897931;
+  const double op0 = t129;
   const double op1 = 0.0;
   const double op2 = 0.0;
-  const double op3 = t100;
+  const double op3 = t128;
   double B_linear[1], Cy_linear[4], Cv_linear[4];
   const int computed_status = spherical_pendulum_conical_linear(y0, yd0, p, M, D, Ks, B_linear, Cy_linear, Cv_linear);
   split_symmetric(D, G, 2, "000x", "0xx0");
@@ -186,9 +187,9 @@ extern "C" int spherical_pendulum_conical_outputs(const double* y, const double*
   (void)yd;
   (void)p;
   const double t2 = std::cos(y[0]);
-  const double t65 = p[1]*t2;
+  const double t66 = p[1]*t2;
   z[0] = y[0];
-  z[1] = -t65;
+  z[1] = -t66;
   int status = 0;
   if (!all_finite(z, 2)) status = 1;
   return status;

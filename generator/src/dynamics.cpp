@@ -26,6 +26,17 @@ bool has_reactions(const Model& model) {
   return false;
 }
 
+// Adds each body's gravity wrench, negated, −(c × m g, m g) about the world origin.
+void add_gravity_wrenches(const Model& model, const Kinematics& kin, std::vector<Spatial>& wrench) {
+  for (std::size_t i = 0; i < kin.bodies.size(); ++i) {
+    const BodyKinematics& b = kin.bodies[i];
+    for (const auto& g : model.gravity()) {
+      Vec3 force = scale(b.inertia.m, g.g);
+      wrench[i] = add(wrench[i], scale(-1, Spatial{cross(b.inertia.h, g.g), force}));
+    }
+  }
+}
+
 // Per-body wrench of inertia and gravity, I ā + V ×* I V − (c × m g, m g), about the world origin.
 std::vector<Spatial> inertial_wrenches(const Model& model, Equations& eq) {
   Program& prog = eq.program;
@@ -38,11 +49,8 @@ std::vector<Spatial> inertial_wrenches(const Model& model, Equations& eq) {
       Spatial IV = define(prog, apply(b.inertia, b.V));
       wrench[i] = add(apply(b.inertia, b.bias), cross_force(b.V, IV));
     }
-    for (const auto& g : model.gravity()) {
-      Vec3 force = scale(b.inertia.m, g.g);
-      wrench[i] = add(wrench[i], scale(-1, Spatial{cross(b.inertia.h, g.g), force}));
-    }
   }
+  add_gravity_wrenches(model, kin, wrench);
   return wrench;
 }
 
@@ -299,7 +307,9 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
       LinkFrameProjection link = project_link_frames(model, prog, eq.y, eq.yd);
       eq.M = std::move(link.M);
       eq.residual = std::move(link.residual);
-      project_wrenches(eq, applied_wrenches(model, eq));
+      std::vector<Spatial> world = applied_wrenches(model, eq);  // with gravity: header
+      add_gravity_wrenches(model, kin, world);
+      project_wrenches(eq, world);
       break;
     }
     case Projection::world_composite:

@@ -299,9 +299,8 @@ LinkFrameProjection project_link_frames(const Model& model, Program& prog,
   LinkFrameProjection out;
   out.M = crba(prog, steps, composite_inertias(prog, steps), f);
 
-  // Forward: velocities v and bias accelerations a (ÿ = 0) with the base accelerating at −g.
-  Spatial base;
-  for (const auto& g : model.gravity()) base.v = sub(base.v, g.g);
+  // Forward: velocities v and bias accelerations a (ÿ = 0); gravity is not here (header).
+  const Spatial base;
   std::vector<Spatial> v(ns), a(ns), F(ns);
   for (std::size_t n = 0; n < ns; ++n) {
     const Step& step = steps[n];

@@ -46,8 +46,8 @@ enum class Projection {
   /// (link_frame_dynamics.hpp) declines (planar ones, those with nonholonomic constraints).
   composite,
   /// Composite-rigid-body and recursive Newton–Euler algorithms in link frames
-  /// (link_frame_dynamics.hpp; fewest operations on spatial trees); applied forces at markers
-  /// are projected as in world_composite.
+  /// (link_frame_dynamics.hpp; fewest operations on spatial trees); gravity and applied forces
+  /// at markers are projected as in world_composite.
   link_frames,
   /// The same algorithms in the world frame: subtree sums I^c and F^c about the world origin,
   /// then M_jk = φ_jᵀ I^c φ_k and (k − q)_j = φ_jᵀ F^c (the default before issue 17 §2).
