@@ -323,6 +323,10 @@ std::vector<Statement> merge_equal_temporaries(const std::vector<Statement>& in,
   ExMap first;  // representative of a temporary's value -> ±its symbol, = the value
   for (const auto& s : in) {
     const ex v = replace(s.value);
+    if (s.temporary && is_a<GiNaC::numeric>(v)) {  // a − a once merged: the constant stands in
+      replace.replaced[s.symbol] = v;
+      continue;
+    }
     if (s.temporary && !trivial(v)) {
       const int sign = order.sign(v);
       const ex rep = sign > 0 ? v : ex(-v);

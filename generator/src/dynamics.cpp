@@ -1,5 +1,6 @@
 #include "mbsgen/generator/dynamics.hpp"
 
+#include "mbsgen/generator/link_frame_dynamics.hpp"
 #include "mbsgen/generator/reactions.hpp"
 
 #include <algorithm>
@@ -25,8 +26,19 @@ bool has_reactions(const Model& model) {
   return false;
 }
 
-// Per-body wrench: inertial minus applied, about the world origin.
-std::vector<Spatial> body_wrenches(const Model& model, Equations& eq) {
+// Adds each body's gravity wrench, negated, −(c × m g, m g) about the world origin.
+void add_gravity_wrenches(const Model& model, const Kinematics& kin, std::vector<Spatial>& wrench) {
+  for (std::size_t i = 0; i < kin.bodies.size(); ++i) {
+    const BodyKinematics& b = kin.bodies[i];
+    for (const auto& g : model.gravity()) {
+      Vec3 force = scale(b.inertia.m, g.g);
+      wrench[i] = add(wrench[i], scale(-1, Spatial{cross(b.inertia.h, g.g), force}));
+    }
+  }
+}
+
+// Per-body wrench of inertia and gravity, I ā + V ×* I V − (c × m g, m g), about the world origin.
+std::vector<Spatial> inertial_wrenches(const Model& model, Equations& eq) {
   Program& prog = eq.program;
   Kinematics& kin = eq.kinematics;
   const std::size_t nb = kin.bodies.size();
@@ -37,11 +49,16 @@ std::vector<Spatial> body_wrenches(const Model& model, Equations& eq) {
       Spatial IV = define(prog, apply(b.inertia, b.V));
       wrench[i] = add(apply(b.inertia, b.bias), cross_force(b.V, IV));
     }
-    for (const auto& g : model.gravity()) {
-      Vec3 force = scale(b.inertia.m, g.g);
-      wrench[i] = add(wrench[i], scale(-1, Spatial{cross(b.inertia.h, g.g), force}));
-    }
   }
+  add_gravity_wrenches(model, kin, wrench);
+  return wrench;
+}
+
+// Per-body wrench of the applied forces, negated (the residual's sign), about the world origin.
+std::vector<Spatial> applied_wrenches(const Model& model, Equations& eq) {
+  Program& prog = eq.program;
+  Kinematics& kin = eq.kinematics;
+  std::vector<Spatial> wrench(kin.bodies.size());
   for (const auto& a : model.applied_forces()) {
     int b = model.body_index(model.marker(a.marker).body);
     if (b < 0) continue;  // a force on the ground does no work
@@ -55,9 +72,35 @@ std::vector<Spatial> body_wrenches(const Model& model, Equations& eq) {
     auto& w = wrench[static_cast<std::size_t>(b)];
     w = add(w, scale(-1, wrench_at_origin(P, F, L)));
   }
-  for (std::size_t i = 0; i < nb; ++i) wrench[i] = define(prog, wrench[i]);
-
   return wrench;
+}
+
+// Per-body wrench: inertial minus applied, about the world origin.
+std::vector<Spatial> body_wrenches(const Model& model, Equations& eq) {
+  std::vector<Spatial> wrench = inertial_wrenches(model, eq);
+  const std::vector<Spatial> applied = applied_wrenches(model, eq);
+  for (std::size_t i = 0; i < wrench.size(); ++i) wrench[i] = define(eq.program, add(wrench[i], applied[i]));
+  return wrench;
+}
+
+bool is_zero(const Spatial& s) {
+  for (int a = 0; a < 3; ++a)
+    if (!s.w[a].is_zero() || !s.v[a].is_zero()) return false;
+  return true;
+}
+
+// (k − q)_j += φ_jᵀ F^c for per-body wrenches (world frame), F^c their subtree sums.
+void project_wrenches(Equations& eq, std::vector<Spatial> Fc) {
+  Program& prog = eq.program;
+  Kinematics& kin = eq.kinematics;
+  for (std::size_t i = Fc.size(); i-- > 0;) {
+    if (is_zero(Fc[i])) continue;
+    Fc[i] = define(prog, Fc[i]);
+    for (const auto& col : kin.bodies[i].columns)
+      eq.residual[static_cast<std::size_t>(col.coordinate)] += dot(col.phi, Fc[i]);
+    const int p = kin.bodies[i].parent;
+    if (p >= 0) Fc[static_cast<std::size_t>(p)] = add(Fc[static_cast<std::size_t>(p)], Fc[i]);
+  }
 }
 
 // J̄_i column by column (coordinate j: the sum of the φ with coordinate j on i's root path),
@@ -254,11 +297,28 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
   const std::size_t f = eq.y.size();
   const std::size_t nb = kin.bodies.size();
 
-  const std::vector<Spatial> wrench = body_wrenches(model, eq);
-  if (options.projection == Projection::naive)
-    project_naive(eq, wrench);
-  else
-    project_composite(eq, wrench);
+  switch (options.projection) {
+    case Projection::composite:
+    case Projection::link_frames: {
+      if (options.projection == Projection::composite && !prefers_link_frames(model)) {
+        project_composite(eq, body_wrenches(model, eq));
+        break;
+      }
+      LinkFrameProjection link = project_link_frames(model, prog, eq.y, eq.yd);
+      eq.M = std::move(link.M);
+      eq.residual = std::move(link.residual);
+      std::vector<Spatial> world = applied_wrenches(model, eq);  // with gravity: header
+      add_gravity_wrenches(model, kin, world);
+      project_wrenches(eq, world);
+      break;
+    }
+    case Projection::world_composite:
+      project_composite(eq, body_wrenches(model, eq));
+      break;
+    case Projection::naive:
+      project_naive(eq, body_wrenches(model, eq));
+      break;
+  }
   add_force_elements(model, eq);
   derive_outputs(model, eq);
 

@@ -111,7 +111,9 @@ TEST(Scenes, PruningReducesOperations) {
   const Generated spinning = generate(rotor, "spinning");
   for (const Generated* g : {&rest, &spinning})
     for (const auto& k : g->code.kernels) EXPECT_LE(k.operations, operations(full.code, k.name)) << k.name;
-  EXPECT_LT(operations(rest.code, "linear"), operations(full.code, "linear") / 2);
+  // At rest the gyroscopic terms go: 43 operations of 214 in world frames, of 79 since the link
+  // frames (issue 17 §2) made those terms cheap; the rest (the bushing's stiffness) is the same.
+  EXPECT_LT(operations(rest.code, "linear"), operations(full.code, "linear") * 2 / 3);
   const Model chain = read_model_file(kSourceDir + "/models/textbook/chain3_sympy.yaml");
   const Generated chain_full = generate(chain, "full");
   for (const char* s : {"no_damping", "frf", "sag"}) {

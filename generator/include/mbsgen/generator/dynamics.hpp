@@ -42,9 +42,16 @@ struct Equations {
 
 /// How derive() projects the Newton–Euler equations of the bodies onto the coordinates.
 enum class Projection {
-  /// Composite-rigid-body and recursive Newton–Euler forms: subtree sums I^c and F^c, then
-  /// M_jk = φ_jᵀ I^c φ_k and (k − q)_j = φ_jᵀ F^c (the default; structure-aware).
+  /// The default: link_frames, or world_composite for the models prefers_link_frames
+  /// (link_frame_dynamics.hpp) declines (planar ones, those with nonholonomic constraints).
   composite,
+  /// Composite-rigid-body and recursive Newton–Euler algorithms in link frames
+  /// (link_frame_dynamics.hpp; fewest operations on spatial trees); gravity and applied forces
+  /// at markers are projected as in world_composite.
+  link_frames,
+  /// The same algorithms in the world frame: subtree sums I^c and F^c about the world origin,
+  /// then M_jk = φ_jᵀ I^c φ_k and (k − q)_j = φ_jᵀ F^c (the default before issue 17 §2).
+  world_composite,
   /// The textbook projection body by body, M = Σ_i J̄_iᵀ Ī_i J̄_i and k − q = Σ_i J̄_iᵀ f̄_i, with
   /// J̄_i the 6×f spatial Jacobian of body i (sums of φ along its root path), Ī_i its spatial
   /// inertia and f̄_i its inertial-minus-applied wrench. The same matrices with more operations;

@@ -39,9 +39,9 @@ FrfMethod parse_frf_method(const std::string& name);
 /// it gets to the conditioning test, nothing otherwise. This is the rule before the solve:
 /// FrequencyResponse with FrfMethod::automatic also takes direct when hessenberg's a-posteriori
 /// backward-error check fails (FrfOptions::hessenberg_backward_error_bar), or when its forward
-/// error at the probe frequencies exceeds 10× direct's (estimated by one step of iterative
-/// refinement of direct's solution; floor 10·f·u) — no method auto picks is more than 10× less
-/// accurate than direct (issue 14).
+/// error at the probe frequencies, in ŷ or in a selected output, exceeds 10× direct's
+/// (estimated by one step of iterative refinement of direct's solution; floor 10·f·u) — no
+/// method auto picks is more than 10× less accurate than direct (issue 14).
 FrfMethod automatic_frf_method(const LinearModel& model, Eigen::Index frequencies);
 
 /// What to do at (or numerically at) a pole of an undamped system.
