@@ -1,5 +1,7 @@
 #include "mbsgen/generator/canonical.hpp"
 
+#include "type_test.hpp"
+
 #include <algorithm>
 #include <set>
 #include <sstream>
@@ -10,7 +12,6 @@ namespace mbsgen {
 
 using GiNaC::ex;
 using GiNaC::ex_to;
-using GiNaC::is_a;
 
 namespace {
 
@@ -34,7 +35,7 @@ std::string to_text(const ex& e) {
   return s.str();
 }
 
-bool commutative(const ex& e) { return is_a<GiNaC::add>(e) || is_a<GiNaC::mul>(e); }
+bool commutative(const ex& e) { return isa<GiNaC::add>(e) || isa<GiNaC::mul>(e); }
 
 }  // namespace
 
@@ -51,7 +52,7 @@ bool even_function(const std::string& name) {
 CanonicalOrder::CanonicalOrder(std::size_t memo_capacity) : capacity_(std::max<std::size_t>(memo_capacity, 1)) {}
 
 void CanonicalOrder::set_sign(const ex& s, int sign) {
-  if (!is_a<GiNaC::symbol>(s)) throw std::logic_error("mbsgen::CanonicalOrder::set_sign: not a symbol");
+  if (!isa<GiNaC::symbol>(s)) throw std::logic_error("mbsgen::CanonicalOrder::set_sign: not a symbol");
   if (const Signed* old = signs_.find(s)) {
     if (old->sign != sign)
       throw std::logic_error("mbsgen::CanonicalOrder::set_sign: sign of " +
@@ -72,7 +73,7 @@ void CanonicalOrder::remember(const ex& e, Signed r) {
 }
 
 CanonicalOrder::Signed CanonicalOrder::signed_key(const ex& e) {
-  if (is_a<GiNaC::symbol>(e)) {
+  if (isa<GiNaC::symbol>(e)) {
     if (const Signed* r = signs_.find(e)) return *r;
     return {text(1, ex_to<GiNaC::symbol>(e).get_name()), 1};
   }
@@ -89,16 +90,16 @@ CanonicalOrder::Signed CanonicalOrder::signed_key(const ex& e) {
 
 CanonicalOrder::Signed CanonicalOrder::compute(const ex& e) {
   Signed r{0, 1};
-  if (is_a<GiNaC::numeric>(e)) {
+  if (isa<GiNaC::numeric>(e)) {
     GiNaC::numeric n = ex_to<GiNaC::numeric>(e);
     if (n.is_real() && n.is_negative()) {
       r.sign = -1;
       n = -n;
     }
     r.key = text(2, to_text(n));
-  } else if (is_a<GiNaC::constant>(e)) {
+  } else if (isa<GiNaC::constant>(e)) {
     r.key = text(2, to_text(e));
-  } else if (is_a<GiNaC::add>(e)) {
+  } else if (isa<GiNaC::add>(e)) {
     std::vector<std::pair<std::uint64_t, int>> terms;
     for (std::size_t i = 0; i < e.nops(); ++i) {
       Signed t = signed_key(e.op(i));
@@ -108,13 +109,13 @@ CanonicalOrder::Signed CanonicalOrder::compute(const ex& e) {
     r.sign = terms.empty() ? 1 : terms.front().second;
     r.key = 3;
     for (const auto& [k, s] : terms) r.key = mix(mix(r.key, k), static_cast<std::uint64_t>(s * r.sign + 1));
-  } else if (is_a<GiNaC::mul>(e)) {
+  } else if (isa<GiNaC::mul>(e)) {
     std::vector<std::uint64_t> factors;
     for (std::size_t i = 0; i < e.nops(); ++i) {
       const ex& f = e.op(i);
       Signed t = signed_key(f);
       r.sign *= t.sign;
-      if (is_a<GiNaC::numeric>(f) && (f.is_equal(1) || f.is_equal(-1))) continue;
+      if (isa<GiNaC::numeric>(f) && (f.is_equal(1) || f.is_equal(-1))) continue;
       factors.push_back(t.key);
     }
     std::sort(factors.begin(), factors.end());
@@ -124,17 +125,17 @@ CanonicalOrder::Signed CanonicalOrder::compute(const ex& e) {
       r.key = 4;
       for (std::uint64_t k : factors) r.key = mix(r.key, k);
     }
-  } else if (is_a<GiNaC::power>(e)) {
+  } else if (isa<GiNaC::power>(e)) {
     Signed b = signed_key(e.op(0));
     Signed x = signed_key(e.op(1));
     r.key = mix(mix(5, b.key), mix(x.key, static_cast<std::uint64_t>(x.sign + 1)));
     const ex& n = e.op(1);
-    if (is_a<GiNaC::numeric>(n) && ex_to<GiNaC::numeric>(n).is_integer()) {
+    if (isa<GiNaC::numeric>(n) && ex_to<GiNaC::numeric>(n).is_integer()) {
       if (ex_to<GiNaC::numeric>(n).is_odd()) r.sign = b.sign;
     } else {
       r.key = mix(r.key, static_cast<std::uint64_t>(b.sign + 1));  // the base's sign matters
     }
-  } else if (is_a<GiNaC::function>(e)) {
+  } else if (isa<GiNaC::function>(e)) {
     const std::string name = ex_to<GiNaC::function>(e).get_name();
     r.key = text(6, name);
     if (e.nops() == 1 && (odd_function(name) || even_function(name))) {

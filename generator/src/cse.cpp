@@ -1,5 +1,7 @@
 #include "mbsgen/generator/cse.hpp"
 
+#include "type_test.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cstdint>
@@ -12,17 +14,16 @@ namespace mbsgen {
 
 using GiNaC::ex;
 using GiNaC::ex_to;
-using GiNaC::is_a;
 
 namespace {
 
 bool trivial(const ex& e) {
-  if (is_a<GiNaC::symbol>(e) || is_a<GiNaC::numeric>(e) || is_a<GiNaC::constant>(e)) return true;
-  return is_a<GiNaC::mul>(e) && e.nops() == 2 && is_a<GiNaC::numeric>(e.op(1)) && is_a<GiNaC::symbol>(e.op(0));
+  if (isa<GiNaC::symbol>(e) || isa<GiNaC::numeric>(e) || isa<GiNaC::constant>(e)) return true;
+  return isa<GiNaC::mul>(e) && e.nops() == 2 && isa<GiNaC::numeric>(e.op(1)) && isa<GiNaC::symbol>(e.op(0));
 }
 
 bool integer_power(const ex& e) {
-  return is_a<GiNaC::power>(e) && is_a<GiNaC::numeric>(e.op(1)) && ex_to<GiNaC::numeric>(e.op(1)).is_integer();
+  return isa<GiNaC::power>(e) && isa<GiNaC::numeric>(e.op(1)) && ex_to<GiNaC::numeric>(e.op(1)).is_integer();
 }
 
 // The sign CppPrinter (emit.cpp) writes e with: −1 when it writes −e (a negation wherever that
@@ -43,7 +44,7 @@ struct Replace : GiNaC::map_function {
   ExMap replaced;
   ExMap memo;
   ex operator()(const ex& e) override {
-    if (is_a<GiNaC::symbol>(e)) {
+    if (isa<GiNaC::symbol>(e)) {
       const ex* r = replaced.find(e);
       return r ? *r : e;
     }
@@ -62,7 +63,7 @@ std::vector<std::size_t> references(const ex& e, const Index& index) {
   while (!stack.empty()) {
     const ex x = stack.back();
     stack.pop_back();
-    if (is_a<GiNaC::symbol>(x)) {
+    if (isa<GiNaC::symbol>(x)) {
       if (auto it = index.find(x); it != index.end()) out.push_back(it->second);
       continue;
     }
@@ -98,16 +99,16 @@ std::vector<Statement> drop_unread(std::vector<Statement> in) {
 // k − 1 per power k, one per call, and a negation per negative argument of a call other than an
 // odd or even function (whose sign the printer moves outside) and of a root.
 std::size_t cost(const ex& e, CanonicalOrder& order) {
-  if (is_a<GiNaC::add>(e)) {
+  if (isa<GiNaC::add>(e)) {
     std::size_t n = e.nops() - 1;
     for (std::size_t i = 0; i < e.nops(); ++i) n += cost(e.op(i), order);
     return n;
   }
-  if (is_a<GiNaC::mul>(e)) {
+  if (isa<GiNaC::mul>(e)) {
     std::size_t n = 0, num = 0, den = 0;
     for (std::size_t i = 0; i < e.nops(); ++i) {
       const ex& f = e.op(i);
-      if (is_a<GiNaC::numeric>(f)) {
+      if (isa<GiNaC::numeric>(f)) {
         num += !(f.is_equal(1) || f.is_equal(-1));
       } else if (integer_power(f) && ex_to<GiNaC::numeric>(f.op(1)).is_negative()) {
         ++den;
@@ -119,7 +120,7 @@ std::size_t cost(const ex& e, CanonicalOrder& order) {
     }
     return n + (num > 0 ? num - 1 : 0) + den;
   }
-  if (is_a<GiNaC::power>(e)) {
+  if (isa<GiNaC::power>(e)) {
     const ex& x = e.op(1);
     if (integer_power(e)) {
       const long k = ex_to<GiNaC::numeric>(x).to_long();
@@ -130,7 +131,7 @@ std::size_t cost(const ex& e, CanonicalOrder& order) {
     if (x.is_equal(GiNaC::numeric(-1, 2))) return n + 2;
     return n + 1 + cost(x, order) + (printed_sign(x, order) < 0);
   }
-  if (is_a<GiNaC::function>(e)) {
+  if (isa<GiNaC::function>(e)) {
     const std::string name = ex_to<GiNaC::function>(e).get_name();
     const bool moves_sign = e.nops() == 1 && (odd_function(name) || even_function(name));
     std::size_t n = 1;
@@ -199,11 +200,11 @@ struct Rewriter : GiNaC::map_function {
   // A lone symbol, number or c·symbol with the aliases put in.
   ex alias(const ex& e) const {
     if (aliases.empty()) return e;
-    if (is_a<GiNaC::symbol>(e)) {
+    if (isa<GiNaC::symbol>(e)) {
       const ex* a = aliases.find(e);
       return a ? *a : e;
     }
-    if (is_a<GiNaC::mul>(e)) return alias(e.op(0)) * alias(e.op(1));
+    if (isa<GiNaC::mul>(e)) return alias(e.op(0)) * alias(e.op(1));
     return e;
   }
 
@@ -220,7 +221,7 @@ struct Rewriter : GiNaC::map_function {
       // power of a negative-signed base, e.g. t^-1, stays the product (t^-1)·(−1), whose child
       // is e itself: map e's children instead of recursing into e forever.
       bool wraps = false;
-      if (sign < 0 && is_a<GiNaC::mul>(rep))
+      if (sign < 0 && isa<GiNaC::mul>(rep))
         for (std::size_t i = 0; i < rep.nops(); ++i) wraps = wraps || rep.op(i).is_equal(e);
       ex mapped = wraps ? ex(-map_children(e)) : map_children(rep);
       GiNaC::symbol tmp("c" + std::to_string(next++));
@@ -251,9 +252,9 @@ std::vector<Statement> share_subtrees(const std::vector<Statement>& in, Canonica
   // output sums (weight 1/4, to break ties: they may decide the sign of the sum).
   std::unordered_map<ex, std::pair<double, double>, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> as_output;  // +t, −t
   auto note = [&](const ex& e, double weight) {
-    if (is_a<GiNaC::symbol>(e)) {
+    if (isa<GiNaC::symbol>(e)) {
       as_output[e].first += weight;
-    } else if (trivial(e) && is_a<GiNaC::mul>(e)) {
+    } else if (trivial(e) && isa<GiNaC::mul>(e)) {
       auto& n = as_output[e.op(0)];
       (ex_to<GiNaC::numeric>(e.op(1)).is_negative() ? n.second : n.first) += weight;
     }
@@ -264,7 +265,7 @@ std::vector<Statement> share_subtrees(const std::vector<Statement>& in, Canonica
     reps.push_back(count(s.value, counts, order));
     if (s.temporary) continue;
     note(s.value, 1);
-    if (is_a<GiNaC::add>(s.value))
+    if (isa<GiNaC::add>(s.value))
       for (std::size_t i = 0; i < s.value.nops(); ++i) note(s.value.op(i), 0.25);
   }
   std::vector<Statement> out;
@@ -323,7 +324,7 @@ std::vector<Statement> merge_equal_temporaries(const std::vector<Statement>& in,
   ExMap first;  // representative of a temporary's value -> ±its symbol, = the value
   for (const auto& s : in) {
     const ex v = replace(s.value);
-    if (s.temporary && is_a<GiNaC::numeric>(v)) {  // a − a once merged: the constant stands in
+    if (s.temporary && isa<GiNaC::numeric>(v)) {  // a − a once merged: the constant stands in
       replace.replaced[s.symbol] = v;
       continue;
     }
@@ -536,8 +537,8 @@ class PolynomialForms {
     const auto k = static_cast<std::uint32_t>(atoms_.size());
     atoms_.push_back(a);
     atom_index_.emplace(a, k);
-    atom_cost_.push_back(is_a<GiNaC::symbol>(a) ? 0 : mbsgen::cost(a, order_));
-    if (is_a<GiNaC::function>(value) && value.nops() == 1) {
+    atom_cost_.push_back(isa<GiNaC::symbol>(a) ? 0 : mbsgen::cost(a, order_));
+    if (isa<GiNaC::function>(value) && value.nops() == 1) {
       const std::string name = ex_to<GiNaC::function>(value).get_name();
       if (name == "sin" || name == "cos") {
         auto& pair = trig_.emplace(value.op(0), std::make_pair(-1L, -1L)).first->second;
@@ -554,16 +555,16 @@ class PolynomialForms {
   Poly leaf(const ex& a) { return Poly{{Powers{{atom(a, a), 1}}, GiNaC::numeric(1)}}; }
 
   std::optional<Poly> convert(const ex& e) {
-    if (is_a<GiNaC::numeric>(e)) {
+    if (isa<GiNaC::numeric>(e)) {
       const GiNaC::numeric& n = ex_to<GiNaC::numeric>(e);
       if (!n.is_real()) return leaf(e);
       return n.is_zero() ? Poly{} : Poly{{Powers{}, n}};
     }
-    if (is_a<GiNaC::symbol>(e)) {
+    if (isa<GiNaC::symbol>(e)) {
       if (auto it = temporaries_.polys.find(e); it != temporaries_.polys.end()) return it->second;
       return leaf(e);
     }
-    if (is_a<GiNaC::add>(e)) {
+    if (isa<GiNaC::add>(e)) {
       // Operands in canonical order, not GiNaC's (which follows hashes that change from run to
       // run): atoms are numbered as first met, and the numbering breaks the factoring's ties.
       Poly sum;
@@ -575,7 +576,7 @@ class PolynomialForms {
       }
       return normalise(std::move(sum));
     }
-    if (is_a<GiNaC::mul>(e)) {
+    if (isa<GiNaC::mul>(e)) {
       std::optional<Poly> product = Poly{{Powers{}, GiNaC::numeric(1)}};
       for (const ex& op : order_.operands(e)) {
         if (!product) break;
@@ -719,7 +720,7 @@ class PolynomialForms {
 };
 
 bool polynomial_node(const ex& e) {
-  return is_a<GiNaC::numeric>(e) || is_a<GiNaC::symbol>(e) || is_a<GiNaC::add>(e) || is_a<GiNaC::mul>(e) ||
+  return isa<GiNaC::numeric>(e) || isa<GiNaC::symbol>(e) || isa<GiNaC::add>(e) || isa<GiNaC::mul>(e) ||
          integer_power(e);
 }
 

@@ -8,6 +8,7 @@
 #include "mbsgen/generator/output_files.hpp"
 
 #include "emit_chunks.hpp"
+#include "type_test.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -24,7 +25,6 @@ namespace mbsgen {
 
 using GiNaC::ex;
 using GiNaC::ex_to;
-using GiNaC::is_a;
 
 std::string identifier(const std::string& name) {
   std::string id;
@@ -84,7 +84,7 @@ class CppPrinter {
       negative = order_.sign(e) < 0;
       return it->second;
     }
-    if (is_a<GiNaC::numeric>(e)) {
+    if (isa<GiNaC::numeric>(e)) {
       GiNaC::numeric n = ex_to<GiNaC::numeric>(e);
       if (n.is_negative()) {
         negative = true;
@@ -92,11 +92,11 @@ class CppPrinter {
       }
       return number(n);
     }
-    if (is_a<GiNaC::constant>(e)) return number(ex_to<GiNaC::numeric>(GiNaC::evalf(e)));
-    if (is_a<GiNaC::symbol>(e))
+    if (isa<GiNaC::constant>(e)) return number(ex_to<GiNaC::numeric>(GiNaC::evalf(e)));
+    if (isa<GiNaC::symbol>(e))
       throw std::runtime_error("mbsgen: unbound symbol in generated code: " +
                                ex_to<GiNaC::symbol>(e).get_name());
-    if (is_a<GiNaC::add>(e)) {
+    if (isa<GiNaC::add>(e)) {
       const std::vector<ex> ops = order_.operands(e);
       std::vector<std::pair<std::string, bool>> terms;
       for (const ex& op : ops) {
@@ -115,14 +115,14 @@ class CppPrinter {
       }
       return s;
     }
-    if (is_a<GiNaC::mul>(e)) {
+    if (isa<GiNaC::mul>(e)) {
       std::vector<std::string> num, den;
       for (const ex& f : order_.operands(e)) {
         bool neg = false;
-        if (is_a<GiNaC::power>(f) && is_a<GiNaC::numeric>(f.op(1)) &&
+        if (isa<GiNaC::power>(f) && isa<GiNaC::numeric>(f.op(1)) &&
             ex_to<GiNaC::numeric>(f.op(1)).is_integer() && ex_to<GiNaC::numeric>(f.op(1)).is_negative()) {
           den.push_back(factor(GiNaC::pow(f.op(0), -f.op(1)), neg));
-        } else if (is_a<GiNaC::numeric>(f)) {
+        } else if (isa<GiNaC::numeric>(f)) {
           std::string n = term(f, neg);
           if (!f.is_equal(1) && !f.is_equal(-1)) num.push_back(n);
         } else {
@@ -142,10 +142,10 @@ class CppPrinter {
       }
       return s;
     }
-    if (is_a<GiNaC::power>(e)) {
+    if (isa<GiNaC::power>(e)) {
       const ex& b = e.op(0);
       const ex& x = e.op(1);
-      if (is_a<GiNaC::numeric>(x)) {
+      if (isa<GiNaC::numeric>(x)) {
         GiNaC::numeric n = ex_to<GiNaC::numeric>(x);
         if (n.is_integer()) {
           long k = n.to_long();
@@ -176,7 +176,7 @@ class CppPrinter {
       ++operations;
       return "std::pow(" + print(b) + ", " + print(x) + ")";
     }
-    if (is_a<GiNaC::function>(e)) {
+    if (isa<GiNaC::function>(e)) {
       static const std::map<std::string, std::string> known = {
           {"sin", "std::sin"},   {"cos", "std::cos"},   {"tan", "std::tan"},   {"exp", "std::exp"},
           {"log", "std::log"},   {"abs", "std::fabs"},  {"asin", "std::asin"}, {"acos", "std::acos"},
@@ -204,7 +204,7 @@ class CppPrinter {
 
  private:
   CanonicalOrder& order_;
-  static bool is_sum(const ex& e) { return is_a<GiNaC::add>(e); }
+  static bool is_sum(const ex& e) { return isa<GiNaC::add>(e); }
   std::string number(const GiNaC::numeric& n) {
     if (!n.is_real()) throw std::runtime_error("mbsgen: complex number in generated code");
     return format_double(n.to_double());
@@ -296,7 +296,7 @@ std::vector<Statement> kernel_statements(const Kernel& k, Program& prog, bool cs
   while (!stack.empty()) {
     ex e = stack.back();
     stack.pop_back();
-    if (is_a<GiNaC::symbol>(e)) {
+    if (isa<GiNaC::symbol>(e)) {
       long i = prog.index_of(e);
       if (i >= 0 && !needed[static_cast<std::size_t>(i)]) {
         needed[static_cast<std::size_t>(i)] = 1;
@@ -339,7 +339,7 @@ std::vector<detail::PrintedStatement> print_statements(const Kernel& k, const st
     if (s.temporary && order.sign(s.symbol) < 0) negative = !negative;
     if (negative) {
       ++printer.operations;
-      rhs = is_a<GiNaC::add>(s.value) ? "-(" + rhs + ")" : "-" + rhs;
+      rhs = isa<GiNaC::add>(s.value) ? "-(" + rhs + ")" : "-" + rhs;
     }
     detail::PrintedStatement p{"", printer.operations - before, "", {}};
     if (s.temporary) {
@@ -367,7 +367,7 @@ void find_reads(const std::vector<Statement>& statements, std::vector<detail::Pr
     while (!stack.empty()) {
       const ex e = stack.back();
       stack.pop_back();
-      if (is_a<GiNaC::symbol>(e)) {
+      if (isa<GiNaC::symbol>(e)) {
         if (auto it = defined.find(e); it != defined.end()) printed[j].reads.push_back(it->second);
         continue;
       }

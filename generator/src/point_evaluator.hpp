@@ -3,6 +3,7 @@
 #pragma once
 
 #include "checked_subs.hpp"
+#include "type_test.hpp"
 #include "mbsgen/generator/ex_table.hpp"
 #include "mbsgen/generator/linearize.hpp"
 #include "mbsgen/generator/program.hpp"
@@ -14,6 +15,7 @@
 #include <vector>
 
 namespace mbsgen::detail {
+
 
 using GiNaC::ex;
 
@@ -35,7 +37,7 @@ class PointEvaluator {
     while (!stack.empty()) {
       ex e = stack.back();
       stack.pop_back();
-      if (GiNaC::is_a<GiNaC::symbol>(e)) {
+      if (isa<GiNaC::symbol>(e)) {
         const long i = prog_.index_of(e);
         if (i >= 0 && !needed[static_cast<std::size_t>(i)] && !values_.find(e)) {
           needed[static_cast<std::size_t>(i)] = 1;
@@ -57,34 +59,33 @@ class PointEvaluator {
  private:
   static GiNaC::numeric float_of(const ex& e) {
     const ex v = GiNaC::evalf(e);
-    if (!GiNaC::is_a<GiNaC::numeric>(v)) throw std::runtime_error("not a number");
+    if (!isa<GiNaC::numeric>(v)) throw std::runtime_error("not a number");
     return GiNaC::ex_to<GiNaC::numeric>(v);
   }
 
   GiNaC::numeric number(const ex& e) const {
-    using GiNaC::is_a;
-    if (is_a<GiNaC::numeric>(e)) return GiNaC::ex_to<GiNaC::numeric>(e);
-    if (is_a<GiNaC::symbol>(e)) {
+    if (isa<GiNaC::numeric>(e)) return GiNaC::ex_to<GiNaC::numeric>(e);
+    if (isa<GiNaC::symbol>(e)) {
       const GiNaC::numeric* v = values_.find(e);
       if (!v) throw std::runtime_error("unbound symbol");
       return *v;
     }
-    if (is_a<GiNaC::add>(e)) {
+    if (isa<GiNaC::add>(e)) {
       GiNaC::numeric sum = 0;
       for (std::size_t i = 0; i < e.nops(); ++i) sum += number(e.op(i));
       return sum;
     }
-    if (is_a<GiNaC::mul>(e)) {
+    if (isa<GiNaC::mul>(e)) {
       GiNaC::numeric product = 1;
       for (std::size_t i = 0; i < e.nops(); ++i) product *= number(e.op(i));
       return product;
     }
-    if (is_a<GiNaC::power>(e)) {
+    if (isa<GiNaC::power>(e)) {
       const GiNaC::numeric base = number(e.op(0)), exponent = number(e.op(1));
       if (exponent.is_integer()) return base.power(exponent);
       return GiNaC::ex_to<GiNaC::numeric>(base.evalf()).power(exponent);
     }
-    if (is_a<GiNaC::function>(e)) {
+    if (isa<GiNaC::function>(e)) {
       GiNaC::exvector args;
       for (std::size_t i = 0; i < e.nops(); ++i) args.push_back(number(e.op(i)));
       const auto& f = GiNaC::ex_to<GiNaC::function>(e);

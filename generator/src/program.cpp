@@ -1,5 +1,7 @@
 #include "mbsgen/generator/program.hpp"
 
+#include "type_test.hpp"
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -12,7 +14,6 @@ constexpr std::size_t kSumIndexMinTerms = 16;
 
 using GiNaC::ex;
 using GiNaC::ex_to;
-using GiNaC::is_a;
 
 void Program::add_variable(const GiNaC::symbol& s) {
   if (!defs_.empty())
@@ -40,7 +41,7 @@ Program::Bits Program::dependencies(const ex& e) const {
   while (!stack.empty()) {
     ex x = stack.back();
     stack.pop_back();
-    if (is_a<GiNaC::symbol>(x)) {
+    if (isa<GiNaC::symbol>(x)) {
       if (const std::size_t* d = def_index_.find(x)) {
         const Bits& b = deps_[*d];
         for (std::size_t i = 0; i < bits.size(); ++i) bits[i] |= b[i];
@@ -59,7 +60,7 @@ void Program::collect_intermediates(const ex& e, std::vector<std::size_t>& out) 
   while (!stack.empty()) {
     ex x = stack.back();
     stack.pop_back();
-    if (is_a<GiNaC::symbol>(x)) {
+    if (isa<GiNaC::symbol>(x)) {
       if (const std::size_t* d = def_index_.find(x)) out.push_back(*d);
       continue;
     }
@@ -73,9 +74,9 @@ namespace {
 
 // Functions (sin, cos, sqrt, …) and non-integer powers: what define() names on its own.
 bool internable(const ex& e) {
-  return is_a<GiNaC::function>(e) ||
-         (is_a<GiNaC::power>(e) &&
-          !(is_a<GiNaC::numeric>(e.op(1)) && ex_to<GiNaC::numeric>(e.op(1)).is_integer()));
+  return isa<GiNaC::function>(e) ||
+         (isa<GiNaC::power>(e) &&
+          !(isa<GiNaC::numeric>(e.op(1)) && ex_to<GiNaC::numeric>(e.op(1)).is_integer()));
 }
 
 bool holds_internable(const ex& e) {
@@ -90,9 +91,9 @@ bool holds_internable(const ex& e) {
 }
 
 bool trivial(const ex& e) {  // a number, a symbol or c·symbol: never named
-  return is_a<GiNaC::numeric>(e) || is_a<GiNaC::symbol>(e) ||
-         (is_a<GiNaC::mul>(e) && e.nops() == 2 && is_a<GiNaC::numeric>(e.op(1)) &&
-          is_a<GiNaC::symbol>(e.op(0)));
+  return isa<GiNaC::numeric>(e) || isa<GiNaC::symbol>(e) ||
+         (isa<GiNaC::mul>(e) && e.nops() == 2 && isa<GiNaC::numeric>(e.op(1)) &&
+          isa<GiNaC::symbol>(e.op(0)));
 }
 
 }  // namespace
@@ -100,7 +101,7 @@ bool trivial(const ex& e) {  // a number, a symbol or c·symbol: never named
 // Functions (sin, cos, sqrt, …) and non-integer powers become intermediates of their own, so
 // that sin and cos of each angle are computed once however often derivatives recreate them.
 ex Program::intern_functions(const ex& e) {
-  if (is_a<GiNaC::symbol>(e) || is_a<GiNaC::numeric>(e)) return e;
+  if (isa<GiNaC::symbol>(e) || isa<GiNaC::numeric>(e)) return e;
   const bool named = internable(e);
   if (!named && e.nops() == 0) return e;
   if (const ex* r = interned_.find(e)) return *r;
@@ -120,7 +121,7 @@ ex Program::intern_functions(const ex& e) {
 }
 
 ex Program::define(const ex& e0) {
-  if (is_a<GiNaC::numeric>(e0) || is_a<GiNaC::symbol>(e0)) return e0;
+  if (isa<GiNaC::numeric>(e0) || isa<GiNaC::symbol>(e0)) return e0;
   // Without functions and roots there is nothing to intern: no walk that hashes every node
   // (most definitions are derivatives, polynomials in the intermediates).
   return holds_internable(e0) ? define_node(intern_functions(e0)) : define_plain(e0);
@@ -129,7 +130,7 @@ ex Program::define(const ex& e0) {
 ex Program::define_node(const ex& e) {
   if (trivial(e)) return e;
   const ex* known = interned_.find(e);
-  if (known && is_a<GiNaC::symbol>(*known)) return *known;
+  if (known && isa<GiNaC::symbol>(*known)) return *known;
   const bool recorded = known != nullptr;
   const ex t = add_definition(e);
   if (!recorded) interned_.insert(e, t);  // (an entry already there is kept, as emplace did)
@@ -141,7 +142,7 @@ ex Program::define_plain(const ex& e) {
   // The form interning gave an expression with functions has its symbol; an expression without
   // any is named anew (intern_functions records it as itself, not as a symbol), and CSE merges
   // equal temporaries when a kernel is emitted.
-  if (const ex* known = interned_.find(e); known && is_a<GiNaC::symbol>(*known)) return *known;
+  if (const ex* known = interned_.find(e); known && isa<GiNaC::symbol>(*known)) return *known;
   return add_definition(e);
 }
 
@@ -175,7 +176,7 @@ ex Program::diff_intermediate(std::size_t k, std::size_t variable) {
   ex value = defs_[k].value;  // copy: define() may reallocate defs_
   // A long sum: only its terms that depend on the variable (the others differentiate to 0, so
   // the result is the same expression, in time proportional to those terms).
-  if (is_a<GiNaC::add>(value) && value.nops() > kSumIndexMinTerms) {
+  if (isa<GiNaC::add>(value) && value.nops() > kSumIndexMinTerms) {
     GiNaC::exvector terms;
     const auto& index = sum_index(k).terms_of;
     if (auto it = index.find(variable); it != index.end())
@@ -209,7 +210,7 @@ const Program::SumIndex& Program::sum_index(std::size_t k) {
 class Program::Partials {
  public:
   Partials(const Program& program, const ex& e, const GiNaC::symbol& x) : e_(e) {
-    if (!is_a<GiNaC::add>(e)) return;
+    if (!isa<GiNaC::add>(e)) return;
     for (std::size_t i = 0; i < e.nops(); ++i) {
       std::vector<std::size_t> ts;
       bool has_x = false;
@@ -228,7 +229,7 @@ class Program::Partials {
 
  private:
   ex partial(const GiNaC::symbol& s, const std::vector<std::size_t>& terms) const {
-    if (!is_a<GiNaC::add>(e_)) return e_.diff(s);
+    if (!isa<GiNaC::add>(e_)) return e_.diff(s);
     GiNaC::exvector v;
     v.reserve(terms.size());
     for (std::size_t i : terms) v.push_back(e_.op(i).diff(s));
@@ -245,7 +246,7 @@ void Program::collect_symbols(const ex& e, const GiNaC::symbol& x, std::vector<s
   while (!stack.empty()) {
     ex y = stack.back();
     stack.pop_back();
-    if (is_a<GiNaC::symbol>(y)) {
+    if (isa<GiNaC::symbol>(y)) {
       if (const std::size_t* d = def_index_.find(y)) out.push_back(*d);
       else if (y.is_equal(x)) has_x = true;
       continue;
@@ -258,8 +259,8 @@ void Program::collect_symbols(const ex& e, const GiNaC::symbol& x, std::vector<s
 
 ex Program::diff(const ex& e, const GiNaC::symbol& x) {
   const std::size_t var = variable(x, "diff");
-  if (is_a<GiNaC::numeric>(e)) return 0;
-  if (is_a<GiNaC::symbol>(e)) {
+  if (isa<GiNaC::numeric>(e)) return 0;
+  if (isa<GiNaC::symbol>(e)) {
     if (e.is_equal(x)) return 1;
     if (const std::size_t* d = def_index_.find(e)) return diff_intermediate(*d, var);
     return 0;
@@ -287,7 +288,7 @@ ex Program::substitute_intermediate(std::size_t k, Substitution& s) {
 }
 
 ex Program::substitute(const ex& e, Substitution& s) {
-  if (is_a<GiNaC::numeric>(e)) return e;
+  if (isa<GiNaC::numeric>(e)) return e;
   if (s.mask_.empty()) {
     s.mask_.assign((variables_.size() + 63) / 64, 0);
     for (const auto& [key, value] : s.values_) {
@@ -308,7 +309,7 @@ ex Program::substitute(const ex& e, Substitution& s) {
     while (!stack.empty()) {
       const ex x = stack.back();
       stack.pop_back();
-      if (is_a<GiNaC::symbol>(x)) {
+      if (isa<GiNaC::symbol>(x)) {
         if (auto v = s.values_.find(x); v != s.values_.end()) m.insert(*v);
         continue;
       }

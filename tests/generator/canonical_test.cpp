@@ -1,6 +1,8 @@
 // The canonical order's memo is bounded (issue 17 §1): what it forgets is computed again, equal.
 #include "mbsgen/generator/canonical.hpp"
 
+#include "type_test.hpp"  // generator/src: isa<T>, the fast GiNaC::is_a
+
 #include <gtest/gtest.h>
 
 #include <string>
@@ -66,6 +68,38 @@ TEST(CanonicalOrder, KeysAndSignsDoNotDependOnWhatTheMemoForgot) {
   EXPECT_EQ(bounded.sign(t), -1);
   EXPECT_EQ(bounded.signed_symbols(), 1u);
   EXPECT_LE(bounded.memo_size(), 32u);
+}
+
+// isa<T> (type_test.hpp) answers as GiNaC::is_a<T> for every node class, those of its fast path
+// (exact classes), their bases (basic, expairseq) and nodes it leaves to GiNaC (a subclass of
+// symbol, a constant, a relational, a matrix).
+template <class T>
+void expect_isa_as_ginac(const std::vector<ex>& nodes) {
+  for (const ex& e : nodes)
+    EXPECT_EQ(isa<T>(e), GiNaC::is_a<T>(e)) << typeid(T).name() << " of " << e << " ("
+                                            << GiNaC::ex_to<GiNaC::basic>(e).class_name() << ")";
+}
+
+TEST(TypeTest, IsaAnswersAsGinac) {
+  const GiNaC::symbol x("x"), y("y");
+  const GiNaC::realsymbol r("r");
+  const GiNaC::possymbol p("p");
+  const std::vector<ex> nodes = {x, r, p, ex(3), ex(GiNaC::numeric(2, 7)), x + y, x * y,
+                                 GiNaC::pow(x, 3), GiNaC::sqrt(x), GiNaC::sin(x), GiNaC::Pi,
+                                 x == y, GiNaC::matrix{{x, y}}, GiNaC::lst{x, y}};
+  expect_isa_as_ginac<GiNaC::basic>(nodes);
+  expect_isa_as_ginac<GiNaC::symbol>(nodes);
+  expect_isa_as_ginac<GiNaC::realsymbol>(nodes);
+  expect_isa_as_ginac<GiNaC::numeric>(nodes);
+  expect_isa_as_ginac<GiNaC::add>(nodes);
+  expect_isa_as_ginac<GiNaC::mul>(nodes);
+  expect_isa_as_ginac<GiNaC::expairseq>(nodes);
+  expect_isa_as_ginac<GiNaC::power>(nodes);
+  expect_isa_as_ginac<GiNaC::function>(nodes);
+  expect_isa_as_ginac<GiNaC::exprseq>(nodes);
+  expect_isa_as_ginac<GiNaC::constant>(nodes);
+  expect_isa_as_ginac<GiNaC::relational>(nodes);
+  expect_isa_as_ginac<GiNaC::matrix>(nodes);
 }
 
 }  // namespace
