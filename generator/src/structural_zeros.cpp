@@ -23,12 +23,16 @@ namespace {
 struct Target {
   ExMatrix* matrix;
   ZeroPattern* pattern;
+  // A symmetric or skew part, (A ± Aᵀ)/2 (linearize.cpp's split): entry (j, i) is ± entry (i, j)
+  // as an expression, so it is zero where (i, j) is, and is not proved a second time.
+  bool mirrored = false;
 };
 
 std::vector<Target> targets(LinearEquations& lin, StructuralZeros& z) {
-  return {{&lin.M, &z.M},   {&lin.Q, &z.Q}, {&lin.K, &z.K}, {&lin.B, &z.B},   {&lin.Cy, &z.Cy},
-          {&lin.Cv, &z.Cv}, {&lin.D, &z.D}, {&lin.G, &z.G}, {&lin.Ks, &z.Ks}, {&lin.N, &z.N},
-          {&lin.E, &z.E},   {&lin.A, &z.A}, {&lin.Bx, &z.Bx}, {&lin.Cx, &z.Cx}};
+  return {{&lin.M, &z.M},         {&lin.Q, &z.Q},        {&lin.K, &z.K},          {&lin.B, &z.B},
+          {&lin.Cy, &z.Cy},       {&lin.Cv, &z.Cv},      {&lin.D, &z.D, true},    {&lin.G, &z.G, true},
+          {&lin.Ks, &z.Ks, true}, {&lin.N, &z.N, true},  {&lin.E, &z.E},          {&lin.A, &z.A},
+          {&lin.Bx, &z.Bx},       {&lin.Cx, &z.Cx}};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -195,6 +199,31 @@ Proof prove_zero(const ex& written_out, TreeSize& written_size) {
   return reduce_pythagoras(numerator, trig).is_zero() ? Proof::zero : Proof::nonzero;
 }
 
+// What the proofs made of one entry: zero everywhere, at the operating point, or neither, and how
+// many of its candidates stayed unproved (too large).
+struct Outcome {
+  EntryZero zero = EntryZero::nonzero;
+  int unproved = 0;
+};
+
+// Proves entry x zero everywhere (a candidate there), else at the operating point `op` (a
+// candidate there).
+Outcome settle(Program& program, const ex& x, bool candidate_everywhere, bool candidate_at_op,
+               Program::Substitution& op, TreeSize& written_size) {
+  Outcome o;
+  if (candidate_everywhere) {
+    const Proof p = prove_zero(program.inline_all(x), written_size);
+    if (p == Proof::zero) return {EntryZero::everywhere, 0};
+    if (p == Proof::too_large) ++o.unproved;
+  }
+  if (candidate_at_op) {
+    const Proof p = prove_zero(program.inline_all(program.substitute(x, op)), written_size);
+    if (p == Proof::zero) o.zero = EntryZero::at_operating_point;
+    if (p == Proof::too_large) ++o.unproved;
+  }
+  return o;
+}
+
 }  // namespace
 
 StructuralZeros find_structural_zeros(Equations& eq, LinearEquations& lin) {
@@ -228,32 +257,29 @@ StructuralZeros detail::find_structural_zeros(Equations& eq, LinearEquations& li
   TreeSize written_size(kProofBudget + 1);
   for (std::size_t m = 0; m < ts.size(); ++m) {
     ExMatrix& A = *ts[m].matrix;
+    std::vector<std::vector<Outcome>> settled;  // of a mirrored matrix, for its lower triangle
+    if (ts[m].mirrored) settled.assign(A.size(), std::vector<Outcome>(A.size()));
     for (std::size_t i = 0; i < A.size(); ++i)
       for (std::size_t j = 0; j < A[i].size(); ++j) {
         if (A[i][j].is_zero()) {
           (*ts[m].pattern)[i][j] = EntryZero::everywhere;
           continue;
         }
-        EntryZero& result = (*ts[m].pattern)[i][j];
-        if (everywhere[m][i][j] == EntryZero::everywhere) {
-          const Proof p = prove_zero(eq.program.inline_all(A[i][j]), written_size);
-          if (p == Proof::zero) {
-            A[i][j] = 0;
-            result = EntryZero::everywhere;
-            ++z.everywhere;
-            continue;
-          }
-          if (p == Proof::too_large) ++z.unproved;
+        Outcome o;
+        if (ts[m].mirrored && j < i) {
+          o = settled[j][i];  // ± the same expression, settled in an earlier row
+        } else {
+          o = settle(eq.program, A[i][j], everywhere[m][i][j] == EntryZero::everywhere,
+                     given && at_op[m][i][j] == EntryZero::everywhere, op, written_size);
+          if (ts[m].mirrored) settled[i][j] = o;
         }
-        if (given && at_op[m][i][j] == EntryZero::everywhere) {
-          const ex at = eq.program.substitute(A[i][j], op);
-          const Proof p = prove_zero(eq.program.inline_all(at), written_size);
-          if (p == Proof::zero) {
-            result = EntryZero::at_operating_point;
-            ++z.at_operating_point;
-          } else if (p == Proof::too_large) {
-            ++z.unproved;
-          }
+        (*ts[m].pattern)[i][j] = o.zero;
+        z.unproved += o.unproved;
+        if (o.zero == EntryZero::everywhere) {
+          A[i][j] = 0;
+          ++z.everywhere;
+        } else if (o.zero == EntryZero::at_operating_point) {
+          ++z.at_operating_point;
         }
       }
   }

@@ -13,8 +13,10 @@
 #include <ginac/ginac.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace mbsgen {
@@ -93,13 +95,15 @@ class Program {
   CanonicalOrder order_;  // intermediates are numbered in this order, not in GiNaC's
   std::unordered_map<std::uint64_t, GiNaC::ex> diff_memo_;
   std::unordered_map<std::size_t, GiNaC::ex> inline_memo_;
-  // For an intermediate defined as a long sum (a model's potential): per variable, the terms
-  // that depend on it, so that each derivative differentiates only those.
-  struct SumIndex {
-    std::unordered_map<std::size_t, std::vector<std::size_t>> terms_of;  ///< variable → operands
+  // The chain rule's factors of intermediate k: ∂f_k/∂t_j for the intermediates t_j of its value
+  // (j ascending) and ∂f_k/∂x for the variables it holds itself. They do not depend on the
+  // variable differentiated by, so each is formed once, not once per variable.
+  struct ChainFactors {
+    std::vector<std::pair<std::size_t, GiNaC::ex>> intermediates;
+    std::vector<std::pair<std::size_t, GiNaC::ex>> variables;
   };
-  std::unordered_map<std::size_t, SumIndex> sum_index_;
-  const SumIndex& sum_index(std::size_t k);
+  std::vector<std::unique_ptr<ChainFactors>> chain_factors_;
+  const ChainFactors& chain_factors(std::size_t k);
 };
 
 }  // namespace mbsgen
