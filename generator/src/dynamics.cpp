@@ -300,14 +300,17 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
   switch (options.projection) {
     case Projection::composite:
     case Projection::link_frames: {
-      if (options.projection == Projection::composite && !prefers_link_frames(model)) {
+      // Decided on the model as written: the probes of reaction outputs (reactions.hpp) add
+      // rotations about three axes, which would make every planar model with reactions spatial.
+      if (options.projection == Projection::composite && !prefers_link_frames(original)) {
         project_composite(eq, body_wrenches(model, eq));
         break;
       }
       LinkFrameProjection link = project_link_frames(model, prog, eq.y, eq.yd);
       eq.M = std::move(link.M);
       eq.residual = std::move(link.residual);
-      std::vector<Spatial> world = applied_wrenches(model, eq);  // with gravity: header
+      // Gravity and applied forces projected in the world frame (link_frame_dynamics.hpp).
+      std::vector<Spatial> world = applied_wrenches(model, eq);
       add_gravity_wrenches(model, kin, world);
       project_wrenches(eq, world);
       break;

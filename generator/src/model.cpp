@@ -339,6 +339,33 @@ bool exactly_semidefinite(const std::array<std::array<GiNaC::numeric, 3>, 3>& A)
   return !det.is_negative();
 }
 
+// Why R is not a rotation (RᵀR = E, det R = +1) at the default parameter values and two
+// pseudo-random values of the coordinates, or "" (also when it has no numeric value there: the
+// derivation reports that). The kinematics takes Rᵀ for R⁻¹; a matrix that is not orthogonal
+// would give a mass matrix that depends on the route of the projection, with no error.
+std::string rotation_problem(const Mat3& R, GiNaC::exmap values, const std::vector<Coordinate>& coordinates) {
+  for (int sample = 0; sample < 2; ++sample) {
+    for (std::size_t k = 0; k < coordinates.size(); ++k)
+      values[coordinates[k].position] = GiNaC::numeric(0.37 + 0.61 * sample - 0.23 * static_cast<double>(k % 7));
+    Eigen::Matrix3d A;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        bool ok = false;
+        A(i, j) = numeric_value(R[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)], values, ok);
+        if (!ok) return "";
+      }
+    const double off = (A.transpose() * A - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (!(off <= 1e-9)) {
+      std::ostringstream s;
+      s.precision(3);
+      s << "is not orthogonal: an entry of R^T R differs from the identity's by " << off;
+      return s.str();
+    }
+    if (!(A.determinant() > 0)) return "is a reflection (determinant -1), not a rotation";
+  }
+  return "";
+}
+
 bool inertia_is_zero(const Mat3& I, const GiNaC::exmap& defaults) {
   bool ok = false;
   return principal_moments(I, defaults, ok).cwiseAbs().maxCoeff() == 0 && ok;
@@ -576,6 +603,12 @@ void Model::validate() const {
           throw ModelError(b.where, "body '" + b.name + "': the inertia tensor is not symmetric");
     const std::string inertia_error = inertia_problem(b.inertia, defaults, exact_defaults);
     if (!inertia_error.empty()) throw ModelError(b.where, "body '" + b.name + "' has " + inertia_error);
+    if (b.rotation_matrix) {
+      const std::string problem = rotation_problem(*b.rotation_matrix, defaults, coordinates_);
+      if (!problem.empty())
+        throw ModelError(b.where, "body '" + b.name + "': the rotation matrix " + problem +
+                                      " (with the default parameter values)");
+    }
     if (m == 0 && !inertia_is_zero(b.inertia, defaults))
       throw ModelError(b.where, "body '" + b.name +
                                     "' has zero mass but a nonzero inertia tensor (give it a mass, "

@@ -836,6 +836,8 @@ struct FrequencyResponse::Impl {
       ed = std::max(ed, std::abs(dy[i]) / sc[i]);
       eh = std::max(eh, std::abs(yh[i] - ref[i]) / sc[i]);
     }
+    // A solution that is not finite (a probe at a pole) must not pass: std::max drops NaN.
+    if (!ref.allFinite() || !dy.allFinite() || !yh.allFinite()) return {0.0, kInf, 0.0, kInf};
     double zd = 0.0, zh = 0.0;
     if (Cy.rows() > 0) {
       const Eigen::MatrixXcd C = Cy + cd(0.0, om) * Cv;
