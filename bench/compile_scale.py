@@ -7,7 +7,8 @@ For N-link spatial chains (bench/spatial_chain_model.py, 2N coordinates) this me
            kernels cut into parts (several compilers at once) and the first answer; wall time,
            CPU time and the peak memory of all its processes together (sampled every 0.1 s)
   generate `mbsgen generate` alone: its wall time and peak memory, and the operation counts
-  parts    the kernels cut into parts (-O1) and the rest (-O2) compiled as a shared library, 2
+  parts    the kernels cut into parts (at mbsgen run's level: -O2 up to 100,000 operations, else -O1)
+           and the rest (-O2) compiled as a shared library, 2
            compilers at once, and the time per call of mass_matrix, residual and linear
            (bench/kernel_call_timing.cpp: thread CPU time, medians of 51 batches, the variants
            timed in turn in one process)
@@ -90,6 +91,9 @@ def operation_counts(source):
     return {}
 
 
+PARTS_O2_MAX_OPERATIONS = 100000  # generator/tool/run.cpp, kPartsO2MaxOperations
+
+
 def compile_library(compiler, directory, units, jobs, output):
     """Compiles units [(source, level)] to objects, `jobs` at once, and links output.so."""
     t0 = time.perf_counter()
@@ -157,7 +161,9 @@ def main():
                              peak_mb=peak / 1024, ops_mass_matrix=ops.get("mass_matrix"),
                              ops_residual=ops.get("residual"), ops_linear=ops.get("linear"),
                              ops_total=sum(v for k, v in ops.items() if k != "linear_structured")))
-            units = [(os.path.join(parts, f), "-O1") for f in sorted(os.listdir(parts))
+            # The level mbsgen run takes (generator/tool/run.cpp, parts_level).
+            level = "-O2" if sum(v for k, v in ops.items() if k != "linear_structured") <= PARTS_O2_MAX_OPERATIONS else "-O1"
+            units = [(os.path.join(parts, f), level) for f in sorted(os.listdir(parts))
                      if "_part" in f and f.endswith(".cpp")]
             units.append((os.path.join(parts, model_id + ".cpp"), "-O2"))
             sys.stderr.write("[compile_scale] N = %d: compiling the parts\n" % n)

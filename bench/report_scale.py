@@ -32,7 +32,7 @@ def section(results, table, ftime):
            "The N-link spatial chain (`bench/spatial_chain_model.py`, 2N coordinates, universal joints), "
            "by `bench/compile_scale.py`: **run** = `mbsgen run MODEL -- modes` with an empty solver cache "
            "(generation, the kernels cut into parts of 2,500 operations compiled by %s compilers at once — "
-           "parts at -O1, the rest at -O2 —, linking, the first eigenvalues), its wall and CPU time and the peak "
+           "parts at -O2 up to 100,000 operations in all kernels, else at -O1, the rest at -O2 —, linking, the first eigenvalues), its wall and CPU time and the peak "
            "memory of all its processes together; **generate** = `mbsgen generate` alone; ops = operations of "
            "mass_matrix + residual + linear + outputs + bodies (linear_structured calls linear); **kernels "
            "compiled** = the generated files compiled as a shared library the same way." % "2", ""]
@@ -61,8 +61,8 @@ def section(results, table, ftime):
             else:
                 t.append([str(n), k, ftime(a), "–", "–", "–", "–"])
     out += ["Time per call (thread CPU time, medians of 51 batches with the variants in turn, `bench/kernel_call_timing.cpp`): the kernels cut into parts "
-            "(-O1) against the whole kernels in one function each (`--part-operations 0`, -O2, one compiler: "
+            "(-O2 up to 100,000 operations, else -O1, as `mbsgen run` compiles them) against the whole kernels in one function each (`--part-operations 0`, -O2, one compiler: "
             "the form before issue 17), where that still compiles within the run's budget; \"same\" = the "
             "checksums of the outputs agree bit for bit.", "",
-            table(["N", "kernel", "parts, -O1", "whole, -O2", "ratio", "outputs", "whole: compile wall"], t), ""]
+            table(["N", "kernel", "parts", "whole, -O2", "ratio", "outputs", "whole: compile wall"], t), ""]
     return out
