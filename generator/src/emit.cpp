@@ -401,7 +401,7 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
 
   EmittedKernel out;
   std::string body;
-  if (chunk_operations > 0 && operations > chunk_operations && k.computed_by.empty()) {
+  if (chunk_operations > 0 && operations > EmitOptions::kCutFactor * chunk_operations && k.computed_by.empty()) {
     find_reads(statements, printed);
     out.chunks = detail::chunk_body(id + "_kernel_parts::", k.name, parameters, arguments, printed, chunk_operations);
     body = out.chunks.calls;
