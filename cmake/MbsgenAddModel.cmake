@@ -16,7 +16,7 @@
 #               with every character that is not a letter, digit or _ replaced by _)
 #   PARTS       for large models (tens of thousands of operations per kernel): the long kernels'
 #               parts go to <n> files <id>_part1.cpp … that the build compiles in parallel, at
-#               -O1 (as fast for straight-line arithmetic, half the compile time); default 0
+#               -O1 (faster to compile than -O2, and for large models as fast); default 0
 #
 # Documented in docs/cmake.md.
 include_guard(GLOBAL)

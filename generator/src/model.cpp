@@ -339,14 +339,27 @@ bool exactly_semidefinite(const std::array<std::array<GiNaC::numeric, 3>, 3>& A)
   return !det.is_negative();
 }
 
-// Why R is not a rotation (RᵀR = E, det R = +1) at the default parameter values and two
-// pseudo-random values of the coordinates, or "" (also when it has no numeric value there: the
+// Why R is not a rotation (RᵀR = E to 1e-6, det R = +1) at the default parameter values and two
+// sample values of the coordinates, or "" (also when it has no numeric value there: the
 // derivation reports that). The kinematics takes Rᵀ for R⁻¹; a matrix that is not orthogonal
-// would give a mass matrix that depends on the route of the projection, with no error.
+// would give a mass matrix that depends on the route of the projection, with no error. 1e-6
+// admits entries rounded to six decimals (CAD exports); 0.7071 for √2/2 is refused, and the
+// message names the exact form.
 std::string rotation_problem(const Mat3& R, GiNaC::exmap values, const std::vector<Coordinate>& coordinates) {
   for (int sample = 0; sample < 2; ++sample) {
-    for (std::size_t k = 0; k < coordinates.size(); ++k)
-      values[coordinates[k].position] = GiNaC::numeric(0.37 + 0.61 * sample - 0.23 * static_cast<double>(k % 7));
+    std::string at;  // the coordinates R holds, with their sample values
+    for (std::size_t k = 0; k < coordinates.size(); ++k) {
+      const double v = 0.37 + 0.61 * sample - 0.23 * static_cast<double>(k % 7);
+      values[coordinates[k].position] = GiNaC::numeric(v);
+      bool held = false;
+      for (const auto& row : R)
+        for (const auto& x : row) held = held || x.has(coordinates[k].position);
+      if (held) {
+        std::ostringstream s;
+        s << (at.empty() ? " and " : ", ") << coordinates[k].name << " = " << v;
+        at += s.str();
+      }
+    }
     Eigen::Matrix3d A;
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
@@ -355,13 +368,15 @@ std::string rotation_problem(const Mat3& R, GiNaC::exmap values, const std::vect
         if (!ok) return "";
       }
     const double off = (A.transpose() * A - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    if (!(off <= 1e-9)) {
+    const std::string where = " (at the default parameter values" + at + ")";
+    if (!(off <= 1e-6)) {
       std::ostringstream s;
       s.precision(3);
-      s << "is not orthogonal: an entry of R^T R differs from the identity's by " << off;
+      s << "is not orthogonal: an entry of R^T R differs from the identity's by " << off << where
+        << "; write exact values (sqrt(2)/2, not 0.7071)";
       return s.str();
     }
-    if (!(A.determinant() > 0)) return "is a reflection (determinant -1), not a rotation";
+    if (!(A.determinant() > 0)) return "is a reflection (determinant -1), not a rotation" + where;
   }
   return "";
 }
@@ -605,9 +620,7 @@ void Model::validate() const {
     if (!inertia_error.empty()) throw ModelError(b.where, "body '" + b.name + "' has " + inertia_error);
     if (b.rotation_matrix) {
       const std::string problem = rotation_problem(*b.rotation_matrix, defaults, coordinates_);
-      if (!problem.empty())
-        throw ModelError(b.where, "body '" + b.name + "': the rotation matrix " + problem +
-                                      " (with the default parameter values)");
+      if (!problem.empty()) throw ModelError(b.where, "body '" + b.name + "': the rotation matrix " + problem);
     }
     if (m == 0 && !inertia_is_zero(b.inertia, defaults))
       throw ModelError(b.where, "body '" + b.name +
@@ -618,6 +631,8 @@ void Model::validate() const {
     if (m.body != kWorld && !body_index_.count(m.body))
       throw ModelError(m.where, "marker '" + m.name + "' is on an unknown body '" + m.body + "'");
     for (const auto& x : m.position) check_expr(x, m.where, "a marker position", parameters_only);
+    const std::string problem = rotation_problem(m.rotation, defaults, coordinates_);
+    if (!problem.empty()) throw ModelError(m.where, "marker '" + m.name + "': the rotation " + problem);
   }
   for (const auto& s : springs_) {
     check_marker(s.marker_a, s.where, "spring '" + s.name + "'");

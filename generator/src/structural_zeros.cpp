@@ -24,7 +24,10 @@ struct Target {
   ExMatrix* matrix;
   ZeroPattern* pattern;
   // A symmetric or skew part, (A ± Aᵀ)/2 (linearize.cpp's split): entry (j, i) is ± entry (i, j)
-  // as an expression, so it is zero where (i, j) is, and is not proved a second time.
+  // as an expression, so it is zero where (i, j) is, and is not proved a second time. (Of a skew
+  // part, x and −x can differ by a node in the proof's size count: an entry right at the budget
+  // may be settled as its mirror was, where proving it anew would have said otherwise. Both are
+  // sound: nothing becomes zero without a proof of one of the two.)
   bool mirrored = false;
 };
 
