@@ -190,8 +190,11 @@ ex Program::diff_intermediate(std::size_t k, std::size_t variable) {
 
 const Program::ChainFactors& Program::chain_factors(std::size_t k) {
   if (chain_factors_.size() <= k) chain_factors_.resize(defs_.size());
-  if (chain_factors_[k]) return *chain_factors_[k];
-  const ex value = defs_[k].value;
+  if (!chain_factors_[k]) chain_factors_[k] = std::make_unique<ChainFactors>(factors_of(defs_[k].value));
+  return *chain_factors_[k];
+}
+
+Program::ChainFactors Program::factors_of(const ex& value, long only) const {
   // The operands of a sum that hold each intermediate and variable (all of a value that is not
   // a sum), so that each partial differentiates only those: a long sum's other terms would
   // differentiate to 0.
@@ -205,7 +208,8 @@ const Program::ChainFactors& Program::chain_factors(std::size_t k) {
       stack.pop_back();
       if (isa<GiNaC::symbol>(y)) {
         if (const std::size_t* d = def_index_.find(y)) of_intermediate[*d].push_back(i);
-        else if (const std::size_t* v = variable_index_.find(y)) of_variable[*v].push_back(i);
+        else if (const std::size_t* v = variable_index_.find(y); v && (only < 0 || *v == static_cast<std::size_t>(only)))
+          of_variable[*v].push_back(i);
         continue;
       }
       for (std::size_t c = 0; c < y.nops(); ++c) stack.push_back(y.op(c));
@@ -219,64 +223,10 @@ const Program::ChainFactors& Program::chain_factors(std::size_t k) {
     for (std::size_t i : terms) v.push_back(value.op(i).diff(s));
     return GiNaC::add(v);
   };
-  auto factors = std::make_unique<ChainFactors>();
-  for (const auto& [j, terms] : of_intermediate) factors->intermediates.emplace_back(j, partial(defs_[j].symbol, terms));
-  for (const auto& [v, terms] : of_variable) factors->variables.emplace_back(v, partial(variables_[v], terms));
-  chain_factors_[k] = std::move(factors);
-  return *chain_factors_[k];
-}
-
-// ∂e/∂s for each symbol s of e, differentiating only the terms of a sum that hold s: the same
-// expression as e.diff(s) (whose other terms differentiate to 0), without building a zero for
-// every other term at every symbol.
-class Program::Partials {
- public:
-  Partials(const Program& program, const ex& e, const GiNaC::symbol& x) : e_(e) {
-    if (!isa<GiNaC::add>(e)) return;
-    for (std::size_t i = 0; i < e.nops(); ++i) {
-      std::vector<std::size_t> ts;
-      bool has_x = false;
-      program.collect_symbols(e.op(i), x, ts, has_x);
-      for (std::size_t k : ts) terms_of_[k].push_back(i);
-      if (has_x) terms_of_x_.push_back(i);
-    }
-  }
-  /// ∂e/∂x.
-  ex of_variable(const GiNaC::symbol& x) const { return partial(x, terms_of_x_); }
-  /// ∂e/∂t_k for intermediate k with symbol t.
-  ex of_intermediate(std::size_t k, const GiNaC::symbol& t) const {
-    auto it = terms_of_.find(k);
-    return partial(t, it == terms_of_.end() ? std::vector<std::size_t>{} : it->second);
-  }
-
- private:
-  ex partial(const GiNaC::symbol& s, const std::vector<std::size_t>& terms) const {
-    if (!isa<GiNaC::add>(e_)) return e_.diff(s);
-    GiNaC::exvector v;
-    v.reserve(terms.size());
-    for (std::size_t i : terms) v.push_back(e_.op(i).diff(s));
-    return GiNaC::add(v);
-  }
-  const ex& e_;
-  std::unordered_map<std::size_t, std::vector<std::size_t>> terms_of_;
-  std::vector<std::size_t> terms_of_x_;
-};
-
-void Program::collect_symbols(const ex& e, const GiNaC::symbol& x, std::vector<std::size_t>& out,
-                              bool& has_x) const {
-  std::vector<ex> stack{e};
-  while (!stack.empty()) {
-    ex y = stack.back();
-    stack.pop_back();
-    if (isa<GiNaC::symbol>(y)) {
-      if (const std::size_t* d = def_index_.find(y)) out.push_back(*d);
-      else if (y.is_equal(x)) has_x = true;
-      continue;
-    }
-    for (std::size_t i = 0; i < y.nops(); ++i) stack.push_back(y.op(i));
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  ChainFactors factors;
+  for (const auto& [j, terms] : of_intermediate) factors.intermediates.emplace_back(j, partial(defs_[j].symbol, terms));
+  for (const auto& [v, terms] : of_variable) factors.variables.emplace_back(v, partial(variables_[v], terms));
+  return factors;
 }
 
 ex Program::diff(const ex& e, const GiNaC::symbol& x) {
@@ -287,15 +237,13 @@ ex Program::diff(const ex& e, const GiNaC::symbol& x) {
     if (const std::size_t* d = def_index_.find(e)) return diff_intermediate(*d, var);
     return 0;
   }
-  std::vector<std::size_t> ts;
-  collect_intermediates(e, ts);
-  const Partials partials(*this, e, x);
   // ∂e/∂x + Σ ∂e/∂t_k dt_k/dx, summed once (adding term by term rebuilt the sum each time).
-  GiNaC::exvector terms{partials.of_variable(x)};
-  for (std::size_t k : ts) {
-    ex dt = diff_intermediate(k, var);
-    if (dt.is_zero()) continue;
-    terms.push_back(partials.of_intermediate(k, defs_[k].symbol) * dt);
+  const ChainFactors factors = factors_of(e, static_cast<long>(var));
+  GiNaC::exvector terms;
+  for (const auto& [v, d] : factors.variables) terms.push_back(d);
+  for (const auto& [k, p] : factors.intermediates) {
+    const ex dt = diff_intermediate(k, var);
+    if (!dt.is_zero()) terms.push_back(p * dt);
   }
   return GiNaC::add(terms);
 }

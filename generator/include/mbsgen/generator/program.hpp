@@ -74,10 +74,6 @@ class Program {
   Bits dependencies(const GiNaC::ex& e) const;
   std::size_t variable(const GiNaC::symbol& x, const char* caller) const;
   void collect_intermediates(const GiNaC::ex& e, std::vector<std::size_t>& out) const;
-  // The intermediates of e (sorted, once each), and whether e holds the variable x.
-  void collect_symbols(const GiNaC::ex& e, const GiNaC::symbol& x, std::vector<std::size_t>& out,
-                       bool& has_x) const;
-  class Partials;
   GiNaC::ex intern_functions(const GiNaC::ex& e);
   GiNaC::ex define_node(const GiNaC::ex& e);
   GiNaC::ex define_plain(const GiNaC::ex& e);  // define() of e without functions and roots
@@ -104,6 +100,11 @@ class Program {
   };
   std::vector<std::unique_ptr<ChainFactors>> chain_factors_;
   const ChainFactors& chain_factors(std::size_t k);
+  // The chain rule's factors of an expression: for each intermediate and variable it holds, its
+  // partial, differentiating only the operands of a sum that hold that symbol (the same
+  // expression as value.diff(s), whose other terms would differentiate to 0). With `only` ≥ 0,
+  // the partial of that variable alone among the variables.
+  ChainFactors factors_of(const GiNaC::ex& value, long only = -1) const;
 };
 
 }  // namespace mbsgen
