@@ -40,6 +40,8 @@ extern const double double_pendulum_rods_parameter_defaults[];
 extern const char* const double_pendulum_rods_input_names[];
 extern const char* const double_pendulum_rods_output_names[];
 
+// Kernels (docs/generator.md): matrices column-major. Output arrays must not overlap the inputs:
+// outputs are stored while inputs are still read.
 int double_pendulum_rods_mass_matrix(const double* y, const double* p, double* M);
 int double_pendulum_rods_residual(const double* y, const double* yd, const double* u, const double* p, double* r);
 int double_pendulum_rods_linear(const double* y0, const double* yd0, const double* p, double* M, double* Q, double* K, double* B, double* Cy, double* Cv);

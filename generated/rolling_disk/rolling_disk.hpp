@@ -44,6 +44,8 @@ extern const char* const rolling_disk_speed_names[];
 extern const char* const rolling_disk_reduced_coordinate_names[];
 extern const char* const rolling_disk_reduced_part_names[];
 
+// Kernels (docs/generator.md): matrices column-major. Output arrays must not overlap the inputs:
+// outputs are stored while inputs are still read.
 int rolling_disk_descriptor(const double* y0, const double* yd0, const double* p, double* E, double* A, double* B, double* C);
 int rolling_disk_reduced(const double* y0, const double* yd0, const double* p, double* M, double* Q, double* K, double* B);
 int rolling_disk_operating_point(const double* p, double* y0, double* yd0);

@@ -40,6 +40,8 @@ extern const double rotor_disk_parameter_defaults[];
 extern const char* const rotor_disk_input_names[];
 extern const char* const rotor_disk_output_names[];
 
+// Kernels (docs/generator.md): matrices column-major. Output arrays must not overlap the inputs:
+// outputs are stored while inputs are still read.
 int rotor_disk_mass_matrix(const double* y, const double* p, double* M);
 int rotor_disk_residual(const double* y, const double* yd, const double* u, const double* p, double* r);
 int rotor_disk_linear(const double* y0, const double* yd0, const double* p, double* M, double* Q, double* K, double* B, double* Cy, double* Cv);

@@ -40,6 +40,8 @@ extern const double spherical_pendulum_conical_parameter_defaults[];
 extern const char* const spherical_pendulum_conical_input_names[];
 extern const char* const spherical_pendulum_conical_output_names[];
 
+// Kernels (docs/generator.md): matrices column-major. Output arrays must not overlap the inputs:
+// outputs are stored while inputs are still read.
 int spherical_pendulum_conical_mass_matrix(const double* y, const double* p, double* M);
 int spherical_pendulum_conical_residual(const double* y, const double* yd, const double* u, const double* p, double* r);
 int spherical_pendulum_conical_linear(const double* y0, const double* yd0, const double* p, double* M, double* Q, double* K, double* B, double* Cy, double* Cv);

@@ -40,6 +40,8 @@ extern const double spring_chain_free_free_parameter_defaults[];
 extern const char* const spring_chain_free_free_input_names[];
 extern const char* const spring_chain_free_free_output_names[];
 
+// Kernels (docs/generator.md): matrices column-major. Output arrays must not overlap the inputs:
+// outputs are stored while inputs are still read.
 int spring_chain_free_free_mass_matrix(const double* y, const double* p, double* M);
 int spring_chain_free_free_residual(const double* y, const double* yd, const double* u, const double* p, double* r);
 int spring_chain_free_free_linear(const double* y0, const double* yd0, const double* p, double* M, double* Q, double* K, double* B, double* Cy, double* Cv);

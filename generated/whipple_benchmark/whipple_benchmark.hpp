@@ -53,6 +53,8 @@ extern const char* const whipple_benchmark_speed_names[];
 extern const char* const whipple_benchmark_reduced_coordinate_names[];
 extern const char* const whipple_benchmark_reduced_part_names[];
 
+// Kernels (docs/generator.md): matrices column-major. Output arrays must not overlap the inputs:
+// outputs are stored while inputs are still read.
 int whipple_benchmark_constraints(const double* y, const double* p, double* phi);
 int whipple_benchmark_constraint_jacobian(const double* y, const double* p, double* J);
 int whipple_benchmark_constraint_bias(const double* y, const double* yd, const double* p, double* gamma);

@@ -88,13 +88,14 @@ Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operat
     }
   Program::Substitution op(op_values);
   auto proved = [&](const ExMatrix& A, int sign) {
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
     for (std::size_t i = 0; i < f; ++i)
-      for (std::size_t j = 0; j <= i; ++j) {
-        if (A[i][j].is_zero() && A[j][i].is_zero()) continue;
-        const ex e = A[i][j] + sign * A[j][i];
-        if (!proved_zero(eq.program, at_operating_point ? eq.program.substitute(e, op) : e)) return false;
-      }
-    return true;
+      for (std::size_t j = 0; j <= i; ++j)
+        if (!(A[i][j].is_zero() && A[j][i].is_zero())) pairs.emplace_back(i, j);
+    return all_proved_zero(eq.program, pairs.size(), [&](std::size_t k) {
+      const ex e = A[pairs[k].first][pairs[k].second] + sign * A[pairs[k].second][pairs[k].first];
+      return at_operating_point ? eq.program.substitute(e, op) : e;
+    });
   };
   s.D_zero = s.D_zero && proved(lin.Q, 1);
   s.G_zero = s.G_zero && proved(lin.Q, -1);

@@ -102,7 +102,13 @@ TEST(KernelParts, EveryKernelCutIntoPartsEqualsTheWholeKernelBitForBit) {
 // linear_structured splits linear's Q and K: D + G = Q and Ks + N = K to rounding (each entry of
 // D and G is a half-sum or half-difference of two entries of Q, one rounding each: 2 units of
 // u = 1.1e-16 of the larger of the two), D and Ks exactly symmetric, G and N exactly
-// antisymmetric, and M passed through unchanged.
+// antisymmetric, and M passed through unchanged. An entry of N that the generator proved zero
+// (this chain's K is symmetric for every y, but its N_zero flag is beyond the proof's budget,
+// so only some entries are proved) is an exact 0, and Ks there the mean of K's two entries to
+// one rounding; those two are then evaluations of one function by different operations, equal
+// to their rounding: within 64 u of K's largest entry (an entry's rounding follows the terms it
+// sums, of the matrix's scale, not its own size; the three programs of the engines bench agree
+// on this chain's matrices to 3.3e-15 of the largest entry, 30 u).
 TEST(KernelParts, StructuredKernelSplitsTheLinearKernelsMatrices) {
   for (const State& s : states()) {
     std::vector<double> M(f * f), Q(f * f), K(f * f), B(1), Cy(1), Cv(1), M2(f * f), D(f * f), G(f * f), Ks(f * f),
@@ -114,6 +120,8 @@ TEST(KernelParts, StructuredKernelSplitsTheLinearKernelsMatrices) {
                                                       G.data(), Ks.data(), N.data()),
               0);
     EXPECT_TRUE(same_bits(M, M2));
+    double k_max = 0;
+    for (double x : K) k_max = std::max(k_max, std::abs(x));
     for (int i = 0; i < f; ++i)
       for (int j = 0; j < f; ++j) {
         const int ij = i + f * j, ji = j + f * i;
@@ -123,7 +131,12 @@ TEST(KernelParts, StructuredKernelSplitsTheLinearKernelsMatrices) {
         EXPECT_EQ(N[ij], -N[ji]);
         const double q = std::max(std::abs(Q[ij]), std::abs(Q[ji])), k = std::max(std::abs(K[ij]), std::abs(K[ji]));
         EXPECT_LE(std::abs(D[ij] + G[ij] - Q[ij]), 2 * 1.1102230246251565e-16 * q) << i << ", " << j;
-        EXPECT_LE(std::abs(Ks[ij] + N[ij] - K[ij]), 2 * 1.1102230246251565e-16 * k) << i << ", " << j;
+        if (N[ij] == 0.0 && K[ij] != K[ji]) {
+          EXPECT_LE(std::abs(Ks[ij] - 0.5 * (K[ij] + K[ji])), 1.1102230246251565e-16 * k) << i << ", " << j;
+          EXPECT_LE(std::abs(K[ij] - K[ji]), 64 * 1.1102230246251565e-16 * k_max) << i << ", " << j;
+        } else {
+          EXPECT_LE(std::abs(Ks[ij] + N[ij] - K[ij]), 2 * 1.1102230246251565e-16 * k) << i << ", " << j;
+        }
       }
   }
 }

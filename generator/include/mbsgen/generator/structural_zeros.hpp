@@ -26,6 +26,7 @@
 #include "mbsgen/generator/dynamics.hpp"
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,9 @@ StructuralZeros find_structural_zeros(Equations& eq, LinearEquations& lin);
 /// True when e (an expression of the program) is proved zero for all values of its variables
 /// by the symbolic proof above (false when it is not zero or not proved within the budget).
 bool proved_zero(Program& program, const GiNaC::ex& e);
+/// True when entry(0), …, entry(count − 1) are all proved zero as above; false, before any is
+/// expanded, when one is beyond the budget (entries are formed in order, up to that one).
+bool all_proved_zero(Program& program, std::size_t count, const std::function<GiNaC::ex(std::size_t)>& entry);
 
 /// A matrix's pattern as rows of characters: 'x' nonzero, '0' zero everywhere, 'o' zero at the
 /// operating point (the manifest's "sparsity").
