@@ -12,7 +12,8 @@
 //          MuJoCo: mj_kinematics, mj_comPos, mj_comVel, mj_rne (qfrc_bias); KDL:
 //          ChainDynParam::JntToCoriolis + JntToGravity ("kdl"), or one ChainIdSolver_RNE pass
 //          with q̈ = 0 ("kdl_rne")
-//   M+bias both, MuJoCo sharing its position stages
+//   M+bias both: ours: <id>_dynamics (M and k − q in one kernel, EmitOptions::dynamics, sharing
+//          the sines, cosines and transforms); MuJoCo sharing its position stages; KDL both calls
 // Before timing, M and the bias of every engine are compared on every state: the largest
 // difference over the largest entry must be below 1e-12, else the run stops (exit 1).
 // Repetitions (51; 21 with --quick) of batches of about 2 ms of all engines of a model are
@@ -95,12 +96,13 @@ struct Kernels {
   int n = 0, n_parameters = 0;
   int (*mass_matrix)(const double*, const double*, double*) = nullptr;
   int (*residual)(const double*, const double*, const double*, const double*, double*) = nullptr;
+  int (*dynamics)(const double*, const double*, const double*, const double*, double*, double*) = nullptr;
   const char* const* parameter_names = nullptr;
   const double* parameter_defaults = nullptr;
 };
 
 #define MBSGEN_KERNELS(ID) \
-  Kernels { #ID, ID##_n_coordinates, ID##_n_parameters, ID##_mass_matrix, ID##_residual, ID##_parameter_names, ID##_parameter_defaults }
+  Kernels { #ID, ID##_n_coordinates, ID##_n_parameters, ID##_mass_matrix, ID##_residual, ID##_dynamics, ID##_parameter_names, ID##_parameter_defaults }
 
 /// A model of the benchmark: our kernels, their parameter vector and the same model for the
 /// engines, built from that parameter vector.
@@ -400,7 +402,7 @@ struct Engines {
   States states;
   std::unique_ptr<MuJoCo> mujoco;
   std::unique_ptr<Kdl> kdl;
-  std::vector<double> M, r, u;  // ours
+  std::vector<double> M, r, u, M2, r2;  // ours (M2, r2: the dynamics kernel's)
   /// (engine, quantity) → the largest relative difference to the other engines over the states.
   std::map<std::pair<std::string, std::string>, double> agreement;
 };
@@ -409,11 +411,14 @@ struct Engines {
 /// difference over the states; fills e.agreement. Returns the largest of all.
 double check_agreement(Engines& e, bench::Csv& csv) {
   const std::size_t n = static_cast<std::size_t>(e.c.k.n);
-  double mm = 0, mk = 0, km = 0, mb = 0, kb = 0, rb = 0, kr = 0;
+  double mm = 0, mk = 0, km = 0, mb = 0, kb = 0, rb = 0, kr = 0, dm = 0, dk = 0;
+  e.M2.resize(n * n);
+  e.r2.resize(n);
   for (int s = 0; s < e.states.count; ++s) {
     const double *q = e.states.q_at(s), *qd = e.states.qd_at(s);
     e.c.k.mass_matrix(q, e.c.p.data(), e.M.data());
     e.c.k.residual(q, qd, e.u.data(), e.c.p.data(), e.r.data());
+    e.c.k.dynamics(q, qd, e.u.data(), e.c.p.data(), e.M2.data(), e.r2.data());
     e.mujoco->mass_matrix(q);
     e.mujoco->bias(q, qd);
     e.kdl->mass_matrix(q);
@@ -426,6 +431,10 @@ double check_agreement(Engines& e, bench::Csv& csv) {
     kb = std::max(kb, relative_difference(e.r.data(), e.kdl->bias_sum.data(), n));
     rb = std::max(rb, relative_difference(e.r.data(), e.kdl->tau.data.data(), n));
     kr = std::max(kr, relative_difference(e.kdl->bias_sum.data(), e.mujoco->d->qfrc_bias, n));
+    dm = std::max({dm, relative_difference(e.M2.data(), e.mujoco->M.data(), n * n),
+                   relative_difference(e.r2.data(), e.mujoco->d->qfrc_bias, n)});
+    dk = std::max({dk, relative_difference(e.M2.data(), e.kdl->H.data.data(), n * n),
+                   relative_difference(e.r2.data(), e.kdl->tau.data.data(), n)});
   }
   const std::string N = std::to_string(e.c.links), f = std::to_string(n);
   auto row = [&](const char* quantity, const char* a, const char* b, double v) {
@@ -439,6 +448,8 @@ double check_agreement(Engines& e, bench::Csv& csv) {
   row("bias", "ours", "kdl", kb);
   row("bias", "ours", "kdl_rne", rb);
   row("bias", "kdl", "mujoco", kr);
+  row("M+bias", "ours", "mujoco", dm);  // ours: the dynamics kernel
+  row("M+bias", "ours", "kdl_rne", dk);
   auto& a = e.agreement;
   a[{"ours", "M"}] = std::max(mm, mk);
   a[{"mujoco", "M"}] = std::max(mm, km);
@@ -447,10 +458,11 @@ double check_agreement(Engines& e, bench::Csv& csv) {
   a[{"mujoco", "bias"}] = std::max(mb, kr);
   a[{"kdl", "bias"}] = std::max(kb, kr);
   a[{"kdl_rne", "bias"}] = rb;
-  for (const char* engine : {"ours", "mujoco", "kdl"})
+  for (const char* engine : {"mujoco", "kdl"})
     a[{engine, "M+bias"}] = std::max(a[{engine, "M"}], a[{engine, "bias"}]);
+  a[{"ours", "M+bias"}] = std::max(dm, dk);
   a[{"kdl_rne", "M+bias"}] = std::max(a[{"kdl", "M"}], rb);
-  return std::max({mm, mk, km, mb, kb, rb, kr});
+  return std::max({mm, mk, km, mb, kb, rb, kr, dm, dk});
 }
 
 // ---- timing -------------------------------------------------------------------------------------
@@ -545,14 +557,11 @@ std::vector<Timed> timed_quantities(Engines& e) {
     x.ops = ops;
     v.push_back(std::move(x));
   };
-  const std::size_t ops_M = kernel_operations(k.id, "mass_matrix"), ops_r = kernel_operations(k.id, "residual");
+  const std::size_t ops_M = kernel_operations(k.id, "mass_matrix"), ops_r = kernel_operations(k.id, "residual"),
+                    ops_d = kernel_operations(k.id, "dynamics");
   add("ours", "M", cycle([=](const double* q, const double*) { k.mass_matrix(q, p, M); }), ops_M);
   add("ours", "bias", cycle([=](const double* q, const double* qd) { k.residual(q, qd, u, p, r); }), ops_r);
-  add("ours", "M+bias", cycle([=](const double* q, const double* qd) {
-        k.mass_matrix(q, p, M);
-        k.residual(q, qd, u, p, r);
-      }),
-      ops_M + ops_r);
+  add("ours", "M+bias", cycle([=](const double* q, const double* qd) { k.dynamics(q, qd, u, p, M, r); }), ops_d);
   add("mujoco", "M", cycle([&mj](const double* q, const double*) { mj.mass_matrix(q); }), 0);
   add("mujoco", "bias", cycle([&mj](const double* q, const double* qd) { mj.bias(q, qd); }), 0);
   add("mujoco", "M+bias", cycle([&mj](const double* q, const double* qd) { mj.both(q, qd); }), 0);

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
       mbsgen::LinearEquations lin = mbsgen::linearize(eq);
       mbsgen::EmitOptions options;
       options.id = "spatial_chain_" + std::to_string(n);
+      options.dynamics = true;  // "M+bias": M and k − q in one call
       mbsgen::write_generated(mbsgen::emit(model, eq, lin, options), argv[1]);
     }
   } catch (const std::exception& e) {

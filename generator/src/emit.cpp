@@ -864,7 +864,7 @@ std::string manifest_json(const Model& model, const Equations& eq, const LinearE
 
 // mass_matrix, residual, linear and linear_structured: the second-order model's kernels.
 void second_order_kernels(Equations& eq, const LinearEquations& lin, const std::vector<ex>& y, const std::vector<ex>& yd,
-                          const std::vector<ex>& p, std::vector<Kernel>& kernels) {
+                          const std::vector<ex>& p, bool dynamics, std::vector<Kernel>& kernels) {
   const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
   const std::vector<ex> u(eq.u.begin(), eq.u.end());
   kernels.push_back({"mass_matrix", "M(y, p): f×f mass matrix, column-major",
@@ -873,6 +873,10 @@ void second_order_kernels(Equations& eq, const LinearEquations& lin, const std::
   kernels.push_back({"residual", "k(y, yd) − q(y, yd, u): length f (M(y) ydd + k − q = 0)",
                      {{"y", y}, {"yd", yd}, {"u", u}, {"p", p}},
                      {{"r", eq.residual, ""}}});
+  if (dynamics)
+    kernels.push_back({"dynamics", "M(y) (f×f, column-major) and k − q (length f) in one kernel (EmitOptions::dynamics)",
+                       {{"y", y}, {"yd", yd}, {"u", u}, {"p", p}},
+                       {{"M", column_major(eq.M, f, f), ""}, {"r", eq.residual, ""}}});
   std::vector<ex> none;
   kernels.push_back({"linear",
                      "linearized M, Q, K (f×f), B (f×m), C_y, C_v (r×f) at (y0, yd0), column-major",
@@ -938,7 +942,7 @@ Kernel reduced_kernel(Equations& eq, const LinearEquations& lin, const std::vect
 // The kernels of docs/generator.md, in emission order. With closed loops the coordinates y are
 // the tree's (n), the rates yd the independent ones, and the matrices those of the independent
 // coordinates (f); such kernels are wrapped (Kernel::wrapped).
-std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const LinearEquations& lin) {
+std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const LinearEquations& lin, bool dynamics) {
   const bool loops = eq.loops.active;
   const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
   const std::size_t nb = model.bodies().size();
@@ -964,7 +968,7 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
                          {{"y0", y}, {"p", p}}, {{"C", parts, ""}}});
     }
   } else {
-    second_order_kernels(eq, lin, y, yd, p, kernels);
+    second_order_kernels(eq, lin, y, yd, p, dynamics, kernels);
   }
   kernels.push_back({"operating_point",
                      "operating point y0 (or the initial guess of an equilibrium) and steady rates yd0",
@@ -1074,7 +1078,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   if (reserved_identifier(out.id)) out.id += "_";
   const bool loops = eq.loops.active;
   const std::size_t n = eq.y.size();
-  std::vector<Kernel> kernels = model_kernels(model, eq, lin);
+  std::vector<Kernel> kernels = model_kernels(model, eq, lin, options.dynamics);
   std::ostringstream kernel_code;
   std::vector<std::pair<std::string, std::size_t>> chunks;  // definitions of kernel parts, operations
   if (loops) {
@@ -1094,7 +1098,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
                                      k0.name == "reduced_parts"
                                ? "linear"
                                                                                 : k0.name;
-    if (!scene.emits(as)) continue;
+    if (!scene.emits(as) && k0.name != "dynamics") continue;  // dynamics: only when asked for (EmitOptions)
     Kernel k = k0;
     if (k.computed_by == "linear") {
       if (!scene.emits("linear"))

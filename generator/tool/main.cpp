@@ -140,7 +140,7 @@ int main(int argc, char** argv) try {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("mbsgen ") + mbsgen::kGeneratorVersion, "print the version and exit");
   std::string model_file, out_dir, scene = "full", id;
-  bool no_cse = false;
+  bool no_cse = false, dynamics = false;
   std::size_t parts = 0;
   std::size_t part_operations = 2500;
   auto* check = app.add_subcommand("check", "read and validate a model file (and its operating point)");
@@ -155,6 +155,9 @@ int main(int argc, char** argv) try {
   generate->add_option("--id", id, "C identifier prefix of the kernels (default: the model name, "
                                    "MODEL_SCENE for a scene)");
   generate->add_flag("--no-cse", no_cse, "skip common-subexpression elimination");
+  generate->add_flag("--dynamics", dynamics,
+                     "also emit dynamics(y, yd, u, p, M, r): M and k - q in one kernel sharing their work "
+                     "(for time steps; compiles both again)");
   generate->add_option("--parts", parts,
                        "also write ID_part1.cpp … ID_partN.cpp holding the long kernels' parts, to compile in "
                        "parallel (default 0: all in ID.cpp)")
@@ -198,6 +201,7 @@ int main(int argc, char** argv) try {
     }
     mbsgen::EmitOptions options;
     options.cse = !no_cse;
+    options.dynamics = dynamics;
     options.parts = parts;
     options.chunk_operations = part_operations;
     options.source_file = model_file;

@@ -1,6 +1,7 @@
 // Writes the generated kernels of a model built through the C++ API (chain.hpp), for its full
 // model or one of its scenes, optionally with the kernels cut into parts (EmitOptions::parts,
-// chunk_operations; 0 operations: none cut):
+// chunk_operations; 0 operations: none cut); a full model also gets the dynamics kernel
+// (EmitOptions::dynamics):
 //   gen_api_models planar|spatial|four_bar|ladder N ID OUT_DIR [SCENE [PARTS [CHUNK_OPERATIONS]]]
 #include "mbsgen/generator/chain.hpp"
 #include "mbsgen/generator/emit.hpp"
@@ -25,6 +26,7 @@ int main(int argc, char** argv) {
   mbsgen::LinearEquations lin = mbsgen::linearize(eq);
   mbsgen::EmitOptions options;
   options.id = argv[3];
+  options.dynamics = model.selection().full;
   if (argc >= 7) options.parts = std::stoul(argv[6]);
   if (argc >= 8) options.chunk_operations = std::stoul(argv[7]);
   mbsgen::write_generated(mbsgen::emit(model, eq, lin, options), argv[4]);

@@ -570,6 +570,23 @@ TEST(MbsgenCli, IdThatIsAKeywordIsAUsageError) {
   fs::remove_all(dir);
 }
 
+// --dynamics adds the dynamics kernel (EmitOptions::dynamics) to the header and the manifest;
+// without it there is none (kernel_parts_test.cpp checks its values).
+TEST(MbsgenCli, DynamicsFlagAddsTheDynamicsKernel) {
+  const fs::path dir = temporary_directory();
+  const std::string model = (kCorpus / "unit_backquote.yaml").string();
+  Result r = run({MBSGEN_TOOL, "generate", model, "--id", "plain", "--out", "a"}, dir);
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = run({MBSGEN_TOOL, "generate", model, "--id", "both", "--out", "b", "--dynamics"}, dir);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(slurp(dir / "a" / "plain.hpp").find("_dynamics("), std::string::npos);
+  EXPECT_NE(slurp(dir / "b" / "both.hpp").find("int both_dynamics(const double* y, const double* yd, const double* u, "
+                                                "const double* p, double* M, double* r);"),
+            std::string::npos);
+  EXPECT_NE(slurp(dir / "b" / "both.json").find("\"name\": \"dynamics\""), std::string::npos);
+  fs::remove_all(dir);
+}
+
 // `mbsgen run`: a Bode plot of a model with backquotes in its units runs nothing; a truncated or
 // deleted cached solver is noticed and rebuilt (it used to crash on every run).
 TEST(MbsgenCli, RunRebuildsADamagedCacheEntry) {

@@ -72,6 +72,12 @@ TEST(KernelParts, EveryKernelCutIntoPartsEqualsTheWholeKernelBitForBit) {
               spatial_chain_6_whole_residual(y, yd, u.data(), p, rb.data()));
     EXPECT_TRUE(same_bits(ra, rb)) << "residual";
 
+    std::vector<double> da(f * f), db(f * f);
+    ASSERT_EQ(spatial_chain_6_parts_dynamics(y, yd, u.data(), p, da.data(), ra.data()),
+              spatial_chain_6_whole_dynamics(y, yd, u.data(), p, db.data(), rb.data()));
+    EXPECT_TRUE(same_bits(da, db)) << "dynamics M";
+    EXPECT_TRUE(same_bits(ra, rb)) << "dynamics r";
+
     std::vector<std::vector<double>> la(6, std::vector<double>(f * f)), lb = la;
     ASSERT_EQ(spatial_chain_6_parts_linear(y, yd, p, la[0].data(), la[1].data(), la[2].data(), la[3].data(),
                                            la[4].data(), la[5].data()),
@@ -138,5 +144,23 @@ TEST(KernelParts, StructuredKernelSplitsTheLinearKernelsMatrices) {
           EXPECT_LE(std::abs(Ks[ij] + N[ij] - K[ij]), 2 * 1.1102230246251565e-16 * k) << i << ", " << j;
         }
       }
+  }
+}
+
+// The dynamics kernel (EmitOptions::dynamics) computes M and k − q in one function, its
+// statements merged by one CSE: what mass_matrix and residual compute, to rounding. The same
+// values summed in another association differ by a few units of the scale of the terms summed
+// (the matrix's or vector's largest entry): within 64 u, as for K's pair above.
+TEST(KernelParts, DynamicsKernelEqualsMassMatrixAndResidual) {
+  for (const State& s : states()) {
+    std::vector<double> M(f * f), r(f), M2(f * f), r2(f), u(1, 0.0);
+    ASSERT_EQ(spatial_chain_6_whole_mass_matrix(s.y.data(), s.p.data(), M.data()), 0);
+    ASSERT_EQ(spatial_chain_6_whole_residual(s.y.data(), s.yd.data(), u.data(), s.p.data(), r.data()), 0);
+    ASSERT_EQ(spatial_chain_6_whole_dynamics(s.y.data(), s.yd.data(), u.data(), s.p.data(), M2.data(), r2.data()), 0);
+    double m_max = 0, r_max = 0;
+    for (double x : M) m_max = std::max(m_max, std::abs(x));
+    for (double x : r) r_max = std::max(r_max, std::abs(x));
+    for (int k = 0; k < f * f; ++k) EXPECT_LE(std::abs(M2[k] - M[k]), 64 * 1.1102230246251565e-16 * m_max) << k;
+    for (int k = 0; k < f; ++k) EXPECT_LE(std::abs(r2[k] - r[k]), 64 * 1.1102230246251565e-16 * r_max) << k;
   }
 }

@@ -131,6 +131,29 @@ TEST(FourBarLinkage, AssembleClosesTheLoop) {
   }
 }
 
+// With closed loops the dynamics kernel is wrapped like mass_matrix and residual (it takes the
+// independent coordinates and closes the loops first): the same M and k − q, to rounding (64 u
+// of each one's largest entry: kernel_parts_test.cpp), at the operating point and moved off it.
+TEST(FourBarLinkage, DynamicsKernelEqualsMassMatrixAndResidual) {
+  const double* p = four_bar_linkage_parameter_defaults;
+  const std::size_t f = four_bar_linkage_n_coordinates;
+  std::vector<double> yi(f), yd(f), u(four_bar_linkage_n_inputs + 1, 0.0);
+  ASSERT_EQ(four_bar_linkage_operating_point(p, yi.data(), yd.data()), 0);
+  for (double shift : {0.0, 0.1, -0.1}) {
+    std::vector<double> y = yi, v(f, 0.7);
+    y[0] += shift;
+    std::vector<double> M(f * f), r(f), M2(f * f), r2(f);
+    ASSERT_EQ(four_bar_linkage_mass_matrix(y.data(), p, M.data()), 0);
+    ASSERT_EQ(four_bar_linkage_residual(y.data(), v.data(), u.data(), p, r.data()), 0);
+    ASSERT_EQ(four_bar_linkage_dynamics(y.data(), v.data(), u.data(), p, M2.data(), r2.data()), 0);
+    double m_max = 0, r_max = 0;
+    for (double x : M) m_max = std::max(m_max, std::abs(x));
+    for (double x : r) r_max = std::max(r_max, std::abs(x));
+    for (std::size_t k = 0; k < f * f; ++k) EXPECT_LE(std::abs(M2[k] - M[k]), 64 * 1.1102230246251565e-16 * m_max);
+    for (std::size_t k = 0; k < f; ++k) EXPECT_LE(std::abs(r2[k] - r[k]), 64 * 1.1102230246251565e-16 * r_max);
+  }
+}
+
 // A coupler too short to span the gap (0.05 m where the crank's tip is at least 0.3 m from the
 // rocker's tip's circle): assemble returns 2, and the runtime names the failure.
 TEST(FourBarLinkage, LoopThatCannotCloseIsReported) {

@@ -41,6 +41,10 @@ struct EmitOptions {
   /// whole).
   std::size_t chunk_operations = 2500;
   static constexpr std::size_t kCutFactor = 4;
+  /// Also emit `dynamics(y, yd, u, p, M, r)`: M(y) and k − q in one kernel, sharing the sines,
+  /// cosines and link transforms the two compute (what a time step needs). Off by default: it
+  /// compiles both again.
+  bool dynamics = false;
 };
 
 struct KernelInfo {
