@@ -1,5 +1,5 @@
 # mbsgen_add_model(<target> MODEL <file> [SCENE <name>] [SOLVER] [OUTPUT_DIR <dir>] [ID <id>]
-#                  [PARTS <n>])
+#                  [PARTS <n>] [DYNAMICS])
 #
 # Generates a model's kernels at build time and compiles them into the static library <target>,
 # linked to mbsgen::runtime, with the typed C++ API <id>_model.hpp (namespace <id>: Parameters
@@ -17,12 +17,14 @@
 #   PARTS       for large models (tens of thousands of operations per kernel): the long kernels'
 #               parts go to <n> files <id>_part1.cpp … that the build compiles in parallel, at
 #               -O1 (faster to compile than -O2, and for large models as fast); default 0
+#   DYNAMICS    also emit <id>_dynamics(y, yd, u, p, M, r): M and k − q in one kernel (the full
+#               model only; not for nonholonomic models)
 #
 # Documented in docs/cmake.md.
 include_guard(GLOBAL)
 
 function(mbsgen_add_model target)
-  cmake_parse_arguments(PARSE_ARGV 1 ARG "SOLVER" "MODEL;SCENE;OUTPUT_DIR;ID;PARTS" "")
+  cmake_parse_arguments(PARSE_ARGV 1 ARG "SOLVER;DYNAMICS" "MODEL;SCENE;OUTPUT_DIR;ID;PARTS" "")
   if(ARG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "mbsgen_add_model(${target}): unknown arguments: ${ARG_UNPARSED_ARGUMENTS}")
   endif()
@@ -63,11 +65,15 @@ function(mbsgen_add_model target)
     # The stamp is the rule's output; the generated files are byproducts that the generator
     # rewrites only when their content changes, so an unchanged kernel is not recompiled.
     set(_stamp ${_dir}/${ARG_ID}.stamp)
+    set(_dynamics "")
+    if(ARG_DYNAMICS)
+      set(_dynamics --dynamics)
+    endif()
     add_custom_command(
       OUTPUT ${_stamp}
       BYPRODUCTS ${_files}
       COMMAND mbsgen::mbsgen generate ${_model} --scene ${ARG_SCENE} --id ${ARG_ID} --parts ${ARG_PARTS}
-              --out ${_dir}
+              --out ${_dir} ${_dynamics}
       COMMAND ${CMAKE_COMMAND} -E touch ${_stamp}
       DEPENDS ${_model} mbsgen::mbsgen
       COMMENT "mbsgen: generating ${ARG_ID} from ${ARG_MODEL} (scene ${ARG_SCENE})"

@@ -1078,6 +1078,12 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   if (reserved_identifier(out.id)) out.id += "_";
   const bool loops = eq.loops.active;
   const std::size_t n = eq.y.size();
+  if (options.dynamics && (lin.descriptor || !model.selection().full))
+    throw std::invalid_argument(
+        lin.descriptor ? "the dynamics kernel (--dynamics) needs the second-order form M(y) ydd + k - q = 0, which a "
+                         "model with nonholonomic constraints does not have (its kernels are the descriptor form's)"
+                       : "the dynamics kernel (--dynamics) is emitted for the full model only: scene '" + model.selection().name +
+                             "' prunes effects and, at rest, the velocity terms a time step needs");
   std::vector<Kernel> kernels = model_kernels(model, eq, lin, options.dynamics);
   std::ostringstream kernel_code;
   std::vector<std::pair<std::string, std::size_t>> chunks;  // definitions of kernel parts, operations
@@ -1098,7 +1104,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
                                      k0.name == "reduced_parts"
                                ? "linear"
                                                                                 : k0.name;
-    if (!scene.emits(as) && k0.name != "dynamics") continue;  // dynamics: only when asked for (EmitOptions)
+    if (!scene.emits(as) && k0.name != "dynamics") continue;  // dynamics: when asked for (full model only)
     Kernel k = k0;
     if (k.computed_by == "linear") {
       if (!scene.emits("linear"))

@@ -441,7 +441,7 @@ LoopClosure close_loops(const Model& model, Equations& eq) {
   std::vector<RawEquation> raw;
   for (const auto& c : model.constraints())
     for (auto& r : equations_of(model, prog, eq.kinematics, c)) {
-      if (proved_zero(prog, r.equation.phi))
+      if (proved_zero(prog, r.equation.phi, /*bound_terms=*/false))
         loops.dropped.push_back({r.equation, "identically zero (the motion never violates it)"});
       else
         raw.push_back(std::move(r));

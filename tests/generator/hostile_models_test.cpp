@@ -584,6 +584,18 @@ TEST(MbsgenCli, DynamicsFlagAddsTheDynamicsKernel) {
                                                 "const double* p, double* M, double* r);"),
             std::string::npos);
   EXPECT_NE(slurp(dir / "b" / "both.json").find("\"name\": \"dynamics\""), std::string::npos);
+  // Refused, writing nothing: a nonholonomic model (no second-order form) and a scene (pruned).
+  const fs::path models = fs::path(MBSGEN_SOURCE_DIR) / "models";
+  r = run({MBSGEN_TOOL, "generate", (models / "rolling/rolling_disk.yaml").string(), "--out", "c", "--dynamics"}, dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("needs the second-order form"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "c"));
+  r = run({MBSGEN_TOOL, "generate", (models / "textbook/chain3_sympy.yaml").string(), "--scene", "no_damping", "--out",
+           "d", "--dynamics"},
+          dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("is emitted for the full model only: scene 'no_damping'"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "d"));
   fs::remove_all(dir);
 }
 

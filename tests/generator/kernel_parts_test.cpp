@@ -5,6 +5,7 @@
 // bit, at pseudo-random states and at the operating point (where the exact zeros apply).
 #include "spatial_chain_6_parts.hpp"
 #include "spatial_chain_6_whole.hpp"
+#include "rounding.hpp"
 
 #include <gtest/gtest.h>
 
@@ -126,8 +127,7 @@ TEST(KernelParts, StructuredKernelSplitsTheLinearKernelsMatrices) {
                                                       G.data(), Ks.data(), N.data()),
               0);
     EXPECT_TRUE(same_bits(M, M2));
-    double k_max = 0;
-    for (double x : K) k_max = std::max(k_max, std::abs(x));
+    const double k_max = mbsgen::test::max_abs(K);
     for (int i = 0; i < f; ++i)
       for (int j = 0; j < f; ++j) {
         const int ij = i + f * j, ji = j + f * i;
@@ -136,12 +136,12 @@ TEST(KernelParts, StructuredKernelSplitsTheLinearKernelsMatrices) {
         EXPECT_EQ(G[ij], -G[ji]);
         EXPECT_EQ(N[ij], -N[ji]);
         const double q = std::max(std::abs(Q[ij]), std::abs(Q[ji])), k = std::max(std::abs(K[ij]), std::abs(K[ji]));
-        EXPECT_LE(std::abs(D[ij] + G[ij] - Q[ij]), 2 * 1.1102230246251565e-16 * q) << i << ", " << j;
+        EXPECT_LE(std::abs(D[ij] + G[ij] - Q[ij]), 2 * mbsgen::test::kUnitRoundoff * q) << i << ", " << j;
         if (N[ij] == 0.0 && K[ij] != K[ji]) {
-          EXPECT_LE(std::abs(Ks[ij] - 0.5 * (K[ij] + K[ji])), 1.1102230246251565e-16 * k) << i << ", " << j;
-          EXPECT_LE(std::abs(K[ij] - K[ji]), 64 * 1.1102230246251565e-16 * k_max) << i << ", " << j;
+          EXPECT_LE(std::abs(Ks[ij] - 0.5 * (K[ij] + K[ji])), mbsgen::test::kUnitRoundoff * k) << i << ", " << j;
+          EXPECT_LE(std::abs(K[ij] - K[ji]), 64 * mbsgen::test::kUnitRoundoff * k_max) << i << ", " << j;
         } else {
-          EXPECT_LE(std::abs(Ks[ij] + N[ij] - K[ij]), 2 * 1.1102230246251565e-16 * k) << i << ", " << j;
+          EXPECT_LE(std::abs(Ks[ij] + N[ij] - K[ij]), 2 * mbsgen::test::kUnitRoundoff * k) << i << ", " << j;
         }
       }
   }
@@ -157,10 +157,7 @@ TEST(KernelParts, DynamicsKernelEqualsMassMatrixAndResidual) {
     ASSERT_EQ(spatial_chain_6_whole_mass_matrix(s.y.data(), s.p.data(), M.data()), 0);
     ASSERT_EQ(spatial_chain_6_whole_residual(s.y.data(), s.yd.data(), u.data(), s.p.data(), r.data()), 0);
     ASSERT_EQ(spatial_chain_6_whole_dynamics(s.y.data(), s.yd.data(), u.data(), s.p.data(), M2.data(), r2.data()), 0);
-    double m_max = 0, r_max = 0;
-    for (double x : M) m_max = std::max(m_max, std::abs(x));
-    for (double x : r) r_max = std::max(r_max, std::abs(x));
-    for (int k = 0; k < f * f; ++k) EXPECT_LE(std::abs(M2[k] - M[k]), 64 * 1.1102230246251565e-16 * m_max) << k;
-    for (int k = 0; k < f; ++k) EXPECT_LE(std::abs(r2[k] - r[k]), 64 * 1.1102230246251565e-16 * r_max) << k;
+    EXPECT_LE(mbsgen::test::difference_in_units(M, M2), 64);
+    EXPECT_LE(mbsgen::test::difference_in_units(r, r2), 64);
   }
 }

@@ -38,9 +38,10 @@ struct EmitOptions {
   /// two forms bit for bit). Only kernels longer than kCutFactor × chunk_operations are cut: a
   /// kernel in parts passes its intermediates through memory, and a short one compiles quickly
   /// whole (the 20-coordinate chain's mass matrix, 2,916 operations: 1.6 µs in two parts, 1.0 µs
-  /// whole).
+  /// whole; the 40-coordinate one's, 11,814 operations, 3.96 µs in parts, 2.97 µs whole, in
+  /// bench/compile_scale.py's run on 6802824).
   std::size_t chunk_operations = 2500;
-  static constexpr std::size_t kCutFactor = 4;
+  static constexpr std::size_t kCutFactor = 8;
   /// Also emit `dynamics(y, yd, u, p, M, r)`: M(y) and k − q in one kernel, sharing the sines,
   /// cosines and link transforms the two compute (what a time step needs). Off by default: it
   /// compiles both again.

@@ -59,7 +59,9 @@ StructuralZeros find_structural_zeros(Equations& eq, LinearEquations& lin);
 
 /// True when e (an expression of the program) is proved zero for all values of its variables
 /// by the symbolic proof above (false when it is not zero or not proved within the budget).
-bool proved_zero(Program& program, const GiNaC::ex& e);
+/// bound_terms = false: without the bound on the expansion's terms, only on the written-out
+/// size (loop closure's test of constraint equations that vanish identically, as before).
+bool proved_zero(Program& program, const GiNaC::ex& e, bool bound_terms = true);
 /// True when entry(0), …, entry(count − 1) are all proved zero as above; false, before any is
 /// expanded, when one is beyond the budget (entries are formed in order, up to that one).
 bool all_proved_zero(Program& program, std::size_t count, const std::function<GiNaC::ex(std::size_t)>& entry);
