@@ -142,7 +142,7 @@ int main(int argc, char** argv) try {
   std::string model_file, out_dir, scene = "full", id;
   bool no_cse = false, dynamics = false;
   std::size_t parts = 0;
-  std::size_t part_operations = 2500;
+  std::size_t part_operations = 5000;
   auto* check = app.add_subcommand("check", "read and validate a model file (and its operating point)");
   check->add_option("MODEL", model_file, "model file (YAML)")->required();
   auto* info = app.add_subcommand("info", "scenes, effects, kernels and operation counts");
@@ -163,7 +163,7 @@ int main(int argc, char** argv) try {
                        "parallel (default 0: all in ID.cpp)")
       ->check(CLI::Range(0, 64));
   generate->add_option("--part-operations", part_operations,
-                       "operations per part of a long kernel, one longer than 8 times this (default 2500; 0: no kernel is cut, as before issue 17)")
+                       "operations per part of a long kernel, one longer than 4 times this (default 5000; 0: no kernel is cut, as before issue 17)")
       ->check(CLI::Range(std::size_t{0}, std::size_t{10000000}));
   app.add_subcommand("linear", "modes and frequency responses of raw matrices (mbsgen linear --help)");
   app.add_subcommand("run", "generate, compile, cache and run a model's solver (mbsgen run --help)");

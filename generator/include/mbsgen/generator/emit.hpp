@@ -34,14 +34,17 @@ struct EmitOptions {
   /// parallel (written even when empty, so that a build system can list them in advance).
   std::size_t parts = 0;
   /// Operations per part of a long kernel: GCC's compile time per operation is lowest near
-  /// 2,500 (docs/generator.md, "Compiling large models"); 0: no kernel is cut (tests compare the
+  /// 2,500, but a kernel in parts of 2,500 passes many values through memory (the 40-coordinate
+  /// chain's linear, 48,709 operations, -O2, same run: 34.4 µs in parts of 2,500, 26.2 in parts
+  /// of 5,000, 24.6 in parts of 10,000, 23.0–24.8 whole; compiled in 20.5, 23.2, 60.1 and 66.5 s
+  /// wall on 2 cores): 5,000 (docs/generator.md, "Compiling large models"); 0: no kernel is cut (tests compare the
   /// two forms bit for bit). Only kernels longer than kCutFactor × chunk_operations are cut: a
   /// kernel in parts passes its intermediates through memory, and a short one compiles quickly
   /// whole (the 20-coordinate chain's mass matrix, 2,916 operations: 1.6 µs in two parts, 1.0 µs
   /// whole; the 40-coordinate one's, 11,814 operations, 3.96 µs in parts, 2.97 µs whole, in
   /// bench/compile_scale.py's run on 6802824).
-  std::size_t chunk_operations = 2500;
-  static constexpr std::size_t kCutFactor = 8;
+  std::size_t chunk_operations = 5000;
+  static constexpr std::size_t kCutFactor = 4;
   /// Also emit `dynamics(y, yd, u, p, M, r)`: M(y) and k − q in one kernel, sharing the sines,
   /// cosines and link transforms the two compute (what a time step needs). Off by default: it
   /// compiles both again.
