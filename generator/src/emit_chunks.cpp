@@ -22,6 +22,20 @@ std::vector<std::size_t> assign_chunks(const std::vector<PrintedStatement>& s, s
 
 constexpr std::size_t kNoSlot = static_cast<std::size_t>(-1);
 
+// The statements in the order `order` (a permutation of their indices), with what each reads
+// renumbered to match.
+std::vector<PrintedStatement> permuted(const std::vector<PrintedStatement>& s, const std::vector<std::size_t>& order) {
+  std::vector<std::size_t> position(s.size());
+  for (std::size_t k = 0; k < order.size(); ++k) position[order[k]] = k;
+  std::vector<PrintedStatement> out;
+  out.reserve(s.size());
+  for (std::size_t i : order) {
+    out.push_back(s[i]);
+    for (auto& r : out.back().reads) r = position[r];
+  }
+  return out;
+}
+
 // The statements in the order the outputs demand them: each output (in its original order) right
 // after the locals it reads that are not yet computed, those in their original order, depth
 // first. Values are then computed near their use, so that few cross a part's boundary (the
@@ -55,16 +69,8 @@ std::vector<PrintedStatement> demand_order(const std::vector<PrintedStatement>& 
   }
   for (std::size_t i = 0; i < s.size(); ++i)  // locals no output reads (none in practice)
     if (!placed[i]) order.push_back(i);
-  std::vector<std::size_t> position(s.size());
-  for (std::size_t k = 0; k < order.size(); ++k) position[order[k]] = k;
-  std::vector<PrintedStatement> out;
-  out.reserve(s.size());
-  for (std::size_t i : order) {
-    out.push_back(s[i]);
-    for (auto& r : out.back().reads) r = position[r];
-  }
   original = order;
-  return out;
+  return permuted(s, order);
 }
 
 // Within each part, the statements that define locals in their original (definition) order and
@@ -99,15 +105,7 @@ std::vector<PrintedStatement> order_within_parts(const std::vector<PrintedStatem
     }
     begin = end;
   }
-  std::vector<std::size_t> position(s.size());
-  for (std::size_t k = 0; k < order.size(); ++k) position[order[k]] = k;
-  std::vector<PrintedStatement> out;
-  out.reserve(s.size());
-  for (std::size_t i : order) {
-    out.push_back(s[i]);
-    for (auto& r : out.back().reads) r = position[r];
-  }
-  return out;
+  return permuted(s, order);
 }
 
 }  // namespace
