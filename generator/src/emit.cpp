@@ -1099,12 +1099,14 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   }
   bool split_needed = false;
   for (const auto& k0 : kernels) {
+    // The scene kernel each one comes with (dynamics: asked for, of the full model only).
     const std::string as = k0.name == "outputs_general"                          ? "outputs"
+                           : k0.name == "dynamics"                               ? "mass_matrix"
                            : k0.name == "output_terms" || k0.name == "descriptor" || k0.name == "reduced" ||
                                      k0.name == "reduced_parts"
                                ? "linear"
                                                                                 : k0.name;
-    if (!scene.emits(as) && k0.name != "dynamics") continue;  // dynamics: when asked for (full model only)
+    if (!scene.emits(as)) continue;
     Kernel k = k0;
     if (k.computed_by == "linear") {
       if (!scene.emits("linear"))

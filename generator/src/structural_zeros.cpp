@@ -240,7 +240,6 @@ bool holds_division(const ex& e) {
 
 enum class Proof { zero, nonzero, too_large };
 
-// written_size: a TreeSize with the limit kProofBudget + 1, kept from one candidate to the next.
 // A written-out candidate with sin, cos and tan of each argument as symbols, when it is within
 // the budgets (kProofBudget, kExpansionBudget); nothing otherwise.
 struct ProofForm {
