@@ -4,12 +4,20 @@
 #include "spring_chain_fixed_free.hpp"
 
 #include <cmath>
+#include <cstring>
 
 namespace {
+// Whether x[0..n) are all finite (x·0 is ±0 for a finite x, NaN otherwise).
 bool all_finite(const double* x, int n) {
-  for (int i = 0; i < n; ++i)
-    if (!std::isfinite(x[i])) return false;
-  return true;
+  unsigned long long bits = 0;
+  for (int i = 0; i < n; ++i) {
+    const double zero_or_nan = x[i] * 0.0;
+    unsigned long long b;
+    std::memcpy(&b, &zero_or_nan, sizeof b);
+    bits |= b;
+  }
+  const unsigned long long exponent = 0x7ff0000000000000ull;
+  return (bits & exponent) != exponent;
 }
 // Whether a kernel argument is the operating point's value (to 8 units in the last place).
 inline bool at_operating_point(double argument, double value) {

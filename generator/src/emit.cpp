@@ -483,6 +483,24 @@ std::string structured_from_linear(const std::string& id, const Kernel& k, const
   return c.str();
 }
 
+// The generated file's finiteness check of a kernel's outputs. x·0 is ±0 for a finite x and NaN
+// for an infinite or NaN one, so the OR of the products' bits has every exponent bit set exactly
+// when some x is not finite. Without the branch of an isfinite loop, GCC vectorizes it at -O2: the
+// check of a 24×24 mass matrix went from 210 to 150 ns of a 1.2 µs kernel (issue 17).
+const char* const kAllFinite = R"(// Whether x[0..n) are all finite (x·0 is ±0 for a finite x, NaN otherwise).
+bool all_finite(const double* x, int n) {
+  unsigned long long bits = 0;
+  for (int i = 0; i < n; ++i) {
+    const double zero_or_nan = x[i] * 0.0;
+    unsigned long long b;
+    std::memcpy(&b, &zero_or_nan, sizeof b);
+    bits |= b;
+  }
+  const unsigned long long exponent = 0x7ff0000000000000ull;
+  return (bits & exponent) != exponent;
+}
+)";
+
 // The generated file's helper for structured_from_linear.
 const char* const kSplitSymmetric = R"(// Splits X (n×n, column-major) in place into its symmetric part (X + Xᵀ)/2, left in X, and its
 // skew part (X − Xᵀ)/2 in A; an entry marked '0' in sym or skew (column-major) is an exact zero.
@@ -1161,9 +1179,8 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   for (const auto& o : model.outputs()) on.push_back(o.name);
 
   std::ostringstream c;
-  c << banner << ops.str() << "#include \"" << out.id << ".hpp\"\n\n#include <cmath>\n\n";
-  c << "namespace {\nbool all_finite(const double* x, int n) {\n  for (int i = 0; i < n; ++i)\n"
-       "    if (!std::isfinite(x[i])) return false;\n  return true;\n}\n";
+  c << banner << ops.str() << "#include \"" << out.id << ".hpp\"\n\n#include <cmath>\n#include <cstring>\n\n";
+  c << "namespace {\n" << kAllFinite;
   // An argument equals the operating point's value when it is within 8 units in the last place:
   // the operating_point kernel and this one compute the value by different roundings (a speed
   // v/r as v*(1/r)), and the entries zero at the operating point are of that rounding size there.

@@ -70,14 +70,25 @@ SpatialInertia inertia_to_parent(Program& prog, const Step& step, const SpatialI
   SpatialInertia P;
   P.m = I.m;
   if (step.translation) {
-    // J_P = J_O − [t][h_O] − [h_P][t] with h_P = h_O + m t (parallel axes, h not at the centre).
+    // J_P = J_O − [t][h_O] − [h_P][t] with h_P = h_O + m t (parallel axes, h not at the centre):
+    // J_P,ab = J_O,ab + δ_ab t·(h_O + h_P) − h_O,a t_b − t_a h_P,b. On the diagonal the a-th term
+    // of the dot product cancels the last two, so it is left out rather than added and taken
+    // away again: J_P,aa = J_O,aa + Σ_{c≠a} t_c (h_O,c + h_P,c), exactly J_O,aa along t's axis.
     const Vec3& t = step.t;
     P.h = define(prog, add(I.h, scale(I.m, t)));
-    const ex th = prog.define(dot(t, I.h) + dot(t, P.h));
+    Vec3 arm;  // t_c (h_O,c + h_P,c)
+    for (int c = 0; c < 3; ++c) arm[c] = t[c].is_zero() ? ex(0) : prog.define(t[c] * (I.h[c] + P.h[c]));
     for (int a = 0; a < 3; ++a)
-      for (int b = a; b < 3; ++b)
-        P.J[a][b] = P.J[b][a] =
-            prog.define(I.J[a][b] + (a == b ? th : ex(0)) - I.h[a] * t[b] - t[a] * P.h[b]);
+      for (int b = a; b < 3; ++b) {
+        ex shift = 0;
+        if (a == b) {
+          for (int c = 0; c < 3; ++c)
+            if (c != a) shift += arm[c];
+        } else {
+          shift = -I.h[a] * t[b] - t[a] * P.h[b];
+        }
+        P.J[a][b] = P.J[b][a] = prog.define(I.J[a][b] + shift);
+      }
     return P;
   }
   P.h = define(prog, mul(step.R, I.h));

@@ -161,3 +161,39 @@ TEST(KernelParts, DynamicsKernelEqualsMassMatrixAndResidual) {
     EXPECT_LE(mbsgen::test::difference_in_units(r, r2), 64);
   }
 }
+
+// A kernel returns 1 exactly when one of its outputs is not finite (the generated all_finite,
+// emit.cpp's kAllFinite, ORs the bits of x·0 instead of branching on std::isfinite): infinite or
+// NaN arguments, and finite arguments whose outputs overflow, give 1; outputs near the largest
+// double that are finite give 0. Parameters of the 6-link chain: g, l, m, Ixx, … (index 1 is the
+// link length, 2 the mass).
+TEST(KernelParts, StatusIsOneExactlyWhenAnOutputIsNotFinite) {
+  const State s = states()[1];
+  std::vector<double> M(f * f), r(f), u(1, 0.0);
+  auto mass_matrix = [&](const std::vector<double>& y, const std::vector<double>& p) {
+    return spatial_chain_6_whole_mass_matrix(y.data(), p.data(), M.data());
+  };
+  auto residual = [&](const std::vector<double>& y, const std::vector<double>& p) {
+    return spatial_chain_6_whole_residual(y.data(), s.yd.data(), u.data(), p.data(), r.data());
+  };
+  EXPECT_EQ(mass_matrix(s.y, s.p), 0);
+  EXPECT_EQ(residual(s.y, s.p), 0);
+  for (double bad : {HUGE_VAL, -HUGE_VAL, std::nan("")}) {
+    std::vector<double> y = s.y, p = s.p;
+    y[f - 1] = bad;  // the last coordinate: the tip link's angle, in M's and r's last entries
+    EXPECT_EQ(mass_matrix(y, s.p), 1) << bad;
+    EXPECT_EQ(residual(y, s.p), 1) << bad;
+    p[2] = bad;  // the mass
+    EXPECT_EQ(mass_matrix(s.y, p), 1) << bad;
+    EXPECT_EQ(residual(s.y, p), 1) << bad;
+  }
+  std::vector<double> p = s.p;
+  p[1] = 1e3;    // l: M ~ m l² summed over links
+  p[2] = 1e303;  // m: overflows to infinity from finite arguments
+  EXPECT_EQ(mass_matrix(s.y, p), 1);
+  EXPECT_TRUE(std::any_of(M.begin(), M.end(), [](double x) { return !std::isfinite(x); }));
+  p[2] = 1e290;  // finite outputs near 1e297: no false alarm
+  EXPECT_EQ(mass_matrix(s.y, p), 0);
+  EXPECT_TRUE(std::all_of(M.begin(), M.end(), [](double x) { return std::isfinite(x); }));
+  EXPECT_GT(*std::max_element(M.begin(), M.end()), 1e295);
+}
