@@ -6,7 +6,9 @@ For N-link spatial chains (bench/spatial_chain_model.py, 2N coordinates) this me
   run      `mbsgen run MODEL -- modes` with an empty solver cache: generation, compilation of the
            kernels cut into parts (several compilers at once) and the first answer; wall time,
            CPU time and the peak memory of all its processes together (sampled every 0.1 s)
-  generate `mbsgen generate` alone: its wall time and peak memory, and the operation counts
+  generate `mbsgen generate` alone, --generate-runs times (default 3): the median of its wall and
+           CPU times, its largest peak memory, and the operation counts (one process of the
+           generator runs 10-20 % slower or faster than the next on these shared machines)
   parts    the kernels cut into parts (at mbsgen run's level: -O2 up to 100,000 operations, else -O1)
            and the rest (-O2) compiled as a shared library, 2
            compilers at once, and the time per call of mass_matrix, residual and linear
@@ -18,13 +20,14 @@ For N-link spatial chains (bench/spatial_chain_model.py, 2N coordinates) this me
 Writes compile_scale.csv into OUT_DIR (one row per N and variant) and prints progress to stderr.
 
 usage: compile_scale.py MBSGEN KERNEL_CALL_TIMING OUT_DIR [--links 10,20,30] [--whole-max 20]
-                        [--jobs 2] [--compiler c++]
+                        [--jobs 2] [--compiler c++] [--generate-runs 3]
 """
 import argparse
 import csv
 import os
 import resource
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -137,6 +140,7 @@ def main():
     ap.add_argument("--whole-max", type=int, default=20)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--compiler", default="c++")
+    ap.add_argument("--generate-runs", type=int, default=3)
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     rows = []
@@ -155,7 +159,14 @@ def main():
                              peak_mb=peak / 1024))
             sys.stderr.write("[compile_scale] N = %d: mbsgen generate\n" % n)
             parts = os.path.join(work, "parts-%d" % n)
-            rc, wall, cpu, peak = measured([args.mbsgen, "generate", model, "--out", parts, "--parts", str(2 * args.jobs)])
+            runs = []
+            for _ in range(max(1, args.generate_runs)):
+                shutil.rmtree(parts, ignore_errors=True)
+                runs.append(measured([args.mbsgen, "generate", model, "--out", parts, "--parts", str(2 * args.jobs)]))
+            rc = max(r[0] for r in runs)
+            wall = statistics.median(r[1] for r in runs)
+            cpu = statistics.median(r[2] for r in runs)
+            peak = max(r[3] for r in runs)
             ops = operation_counts(os.path.join(parts, model_id + ".cpp"))
             rows.append(dict(row, variant="generate", status="ok" if rc == 0 else "failed", wall_s=wall, cpu_s=cpu,
                              peak_mb=peak / 1024, ops_mass_matrix=ops.get("mass_matrix"),

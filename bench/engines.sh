@@ -5,8 +5,10 @@
 # scripts/bench.sh (which installs libmujoco-dev and liborocos-kdl-dev); bench/report_engines.py
 # turns the results into a section of docs/accuracy-vs-time.md.
 #
-#   bench/engines.sh [--quick] [--jobs N] [--build DIR] [--out DIR]
+#   bench/engines.sh [--quick] [--jobs N] [--processes K] [--build DIR] [--out DIR]
 #
+#   --processes K  engines_bench runs K times, each a new process; engines.csv has the median over
+#                the processes (bench/engines_merge.py says why; default 5, 1 with --quick)
 #   --build DIR  a build directory configured with -DMBSGEN_BUILD_BENCH=ON (default build/bench;
 #                configured here in Release when it has no CMakeCache.txt)
 #   --out DIR    results: engines.csv, engines_agreement.csv, engines_mjcf/, engines.log
@@ -16,15 +18,17 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 quick=()
 jobs=1
+processes=""
 build=build/bench
 out=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) quick=(--quick) ;;
     --jobs) jobs="$2"; shift ;;
+    --processes) processes="$2"; shift ;;
     --build) build="$2"; shift ;;
     --out) out="$2"; shift ;;
-    *) echo "usage: bench/engines.sh [--quick] [--jobs N] [--build DIR] [--out DIR]" >&2; exit 2 ;;
+    *) echo "usage: bench/engines.sh [--quick] [--jobs N] [--processes K] [--build DIR] [--out DIR]" >&2; exit 2 ;;
   esac
   shift
 done
@@ -51,9 +55,21 @@ ver() { dpkg-query -W -f='${Version}' "$1" 2>/dev/null || echo "?"; }
   echo "mujoco: $(ver libmujoco-dev)"
   echo "orocos_kdl: $(ver liborocos-kdl-dev)"
 } >>"$out/system.txt"
-log "MuJoCo and KDL against our kernels ${quick[*]:-}"
-"$build/bench/engines_bench" "$out" "${quick[@]}" 2>"$out/engines.log" || {
-  tail -30 "$out/engines.log" >&2
-  exit 1
-}
+if [ -z "$processes" ]; then processes=5; [ ${#quick[@]} -gt 0 ] && processes=1; fi
+case "$processes" in ''|*[!0-9]*|0) echo "engines: --processes wants a positive integer" >&2; exit 2 ;; esac
+runs=()
+rm -rf "$out/engines_runs"
+for k in $(seq 1 "$processes"); do
+  log "MuJoCo and KDL against our kernels ${quick[*]:-} (process $k of $processes)"
+  mkdir -p "$out/engines_runs/$k"
+  "$build/bench/engines_bench" "$out/engines_runs/$k" "${quick[@]}" 2>"$out/engines.log" || {
+    tail -30 "$out/engines.log" >&2
+    exit 1
+  }
+  runs+=("$out/engines_runs/$k/engines.csv")
+done
+cp "$out/engines_runs/1/engines_agreement.csv" "$out/engines_agreement.csv"
+rm -rf "$out/engines_mjcf"
+cp -r "$out/engines_runs/1/engines_mjcf" "$out/engines_mjcf" 2>/dev/null || true
+python3 bench/engines_merge.py "$out/engines.csv" "${runs[@]}"
 log "done"

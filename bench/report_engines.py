@@ -97,10 +97,13 @@ def engines_section(results):
         "sines, cosines and transforms: `mbsgen generate --dynamics`), MuJoCo sharing its position stages, KDL "
         "both calls. Medians of %s interleaved repetitions "
         "(batches of about 2 ms cycling through 16 random states, in thread CPU time so that other jobs on the "
-        "shared machine count little; `bench/engines_bench.cpp`). Before timing, the three must agree to 1e-12 "
+        "shared machine count little; `bench/engines_bench.cpp`), then the median over %s processes: one "
+        "process of the same binary runs the 12-link kernels about 10 %% faster or slower than the next, "
+        "whatever it does, as memory placement falls (`bench/engines_merge.py`). Before timing, the three must agree to 1e-12 "
         "(largest difference over largest entry, over the states; *agreement* is the worst pair). "
         "*ratio* = fastest engine / ours: above 1 we are faster."
-        % (system.get("mujoco", "?"), system.get("orocos_kdl", "?"), rows[0].get("repetitions", "?")),
+        % (system.get("mujoco", "?"), system.get("orocos_kdl", "?"), rows[0].get("repetitions", "?"),
+           rows[0].get("processes", "1")),
         "",
         "| model | coords | quantity | ours | ops (ours) | MuJoCo | KDL | ratio | agreement |",
         "|---|---|---|---|---|---|---|---|---|",
