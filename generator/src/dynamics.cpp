@@ -89,15 +89,17 @@ bool is_zero(const Spatial& s) {
   return true;
 }
 
-// (k − q)_j += φ_jᵀ F^c for per-body wrenches (world frame), F^c their subtree sums.
-void project_wrenches(Equations& eq, std::vector<Spatial> Fc) {
+// (k − q)_j += φ_jᵀ F^c for per-body wrenches (world frame), F^c their subtree sums; into
+// eq.residual, or into `residual` when given.
+void project_wrenches(Equations& eq, std::vector<Spatial> Fc, std::vector<ex>* residual = nullptr) {
   Program& prog = eq.program;
   Kinematics& kin = eq.kinematics;
+  std::vector<ex>& r = residual ? *residual : eq.residual;
   for (std::size_t i = Fc.size(); i-- > 0;) {
     if (is_zero(Fc[i])) continue;
     Fc[i] = define(prog, Fc[i]);
     for (const auto& col : kin.bodies[i].columns)
-      eq.residual[static_cast<std::size_t>(col.coordinate)] += dot(col.phi, Fc[i]);
+      r[static_cast<std::size_t>(col.coordinate)] += dot(col.phi, Fc[i]);
     const int p = kin.bodies[i].parent;
     if (p >= 0) Fc[static_cast<std::size_t>(p)] = add(Fc[static_cast<std::size_t>(p)], Fc[i]);
   }
@@ -189,11 +191,13 @@ void project_composite(Equations& eq, const std::vector<Spatial>& wrench) {
     }
 }
 
-// Conservative and dissipative elements (q = −∂V/∂y − ∂R/∂ẏ) and generalized forces.
-void add_force_elements(const Model& model, Equations& eq) {
+// Conservative and dissipative elements (q = −∂V/∂y − ∂R/∂ẏ) and generalized forces: their
+// terms of k − q, length f.
+std::vector<ex> force_element_terms(const Model& model, Equations& eq) {
   Program& prog = eq.program;
   Kinematics& kin = eq.kinematics;
   const std::size_t f = eq.y.size();
+  std::vector<ex> terms(f, 0);
   ex V = 0, R = 0;
   for (const auto& s : model.springs()) {
     Vec3 d = define(prog, sub(kin.marker_position(model, prog, s.marker_b),
@@ -239,11 +243,21 @@ void add_force_elements(const Model& model, Equations& eq) {
   if (!V.is_zero() || !R.is_zero()) {
     ex Vd = prog.define(V), Rd = prog.define(R);
     for (std::size_t j = 0; j < f; ++j)
-      eq.residual[j] += prog.diff(Vd, eq.y[j]) + prog.diff(Rd, eq.yd[j]);
+      terms[j] += prog.diff(Vd, eq.y[j]) + prog.diff(Rd, eq.yd[j]);
   }
   for (const auto& g : model.generalized_forces())
-    eq.residual[static_cast<std::size_t>(model.coordinate_index(g.coordinate))] -= g.value;
+    terms[static_cast<std::size_t>(model.coordinate_index(g.coordinate))] -= g.value;
+  return terms;
+}
 
+// Conservative and dissipative elements (q = −∂V/∂y − ∂R/∂ẏ) and generalized forces, added to
+// eq.residual and, when there is one, to eq.residual_kernel.
+void add_force_elements(const Model& model, Equations& eq) {
+  const std::vector<ex> terms = force_element_terms(model, eq);
+  for (std::size_t j = 0; j < terms.size(); ++j) {
+    eq.residual[j] += terms[j];
+    if (!eq.residual_kernel.empty()) eq.residual_kernel[j] += terms[j];
+  }
 }
 
 void derive_outputs(const Model& model, Equations& eq) {
@@ -311,8 +325,16 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
       eq.residual = std::move(link.residual);
       // Gravity and applied forces projected in the world frame (link_frame_dynamics.hpp).
       std::vector<Spatial> world = applied_wrenches(model, eq);
+      const std::vector<Spatial> applied = world;
       add_gravity_wrenches(model, kin, world);
       project_wrenches(eq, world);
+      // The kernels' form: gravity as the base's acceleration (Equations::residual_kernel).
+      if (!model.gravity().empty() && !has_reactions(original)) {
+        Vec3 g = zero_vec3();
+        for (const auto& field : model.gravity()) g = add(g, field.g);
+        eq.residual_kernel = link_frame_residual_with_gravity(model, prog, eq.y, eq.yd, g);
+        project_wrenches(eq, applied, &eq.residual_kernel);
+      }
       break;
     }
     case Projection::world_composite:
@@ -359,6 +381,9 @@ Equations derive(const Model& model, const DeriveOptions& options) {
   if (has_reactions(model)) reaction_outputs(eq, probes);
   reduce_equations(eq);
   eq.nonholonomic = nonholonomic_constraints(model, eq);
+  // The kernels' form of k − q is the tree's: the loops' and the descriptor form's kernels are
+  // built from `residual` as those stages leave it.
+  if (eq.loops.active || eq.nonholonomic.active) eq.residual_kernel.clear();
   return eq;
 }
 

@@ -888,13 +888,15 @@ void second_order_kernels(Equations& eq, const LinearEquations& lin, const std::
   kernels.push_back({"mass_matrix", "M(y, p): f×f mass matrix, column-major",
                      {{"y", y}, {"p", p}},
                      {{"M", column_major(eq.M, f, f), ""}}});
+  // k − q in the form written for evaluation (Equations::residual_kernel), where there is one.
+  const std::vector<ex>& residual = eq.residual_kernel.empty() ? eq.residual : eq.residual_kernel;
   kernels.push_back({"residual", "k(y, yd) − q(y, yd, u): length f (M(y) ydd + k − q = 0)",
                      {{"y", y}, {"yd", yd}, {"u", u}, {"p", p}},
-                     {{"r", eq.residual, ""}}});
+                     {{"r", residual, ""}}});
   if (dynamics)
     kernels.push_back({"dynamics", "M(y) (f×f, column-major) and k − q (length f) in one kernel (EmitOptions::dynamics)",
                        {{"y", y}, {"yd", yd}, {"u", u}, {"p", p}},
-                       {{"M", column_major(eq.M, f, f), ""}, {"r", eq.residual, ""}}});
+                       {{"M", column_major(eq.M, f, f), ""}, {"r", residual, ""}}});
   std::vector<ex> none;
   kernels.push_back({"linear",
                      "linearized M, Q, K (f×f), B (f×m), C_y, C_v (r×f) at (y0, yd0), column-major",

@@ -301,17 +301,14 @@ bool prefers_link_frames(const Model& model) {
   return false;
 }
 
-LinkFrameProjection project_link_frames(const Model& model, Program& prog,
-                                        const std::vector<GiNaC::symbol>& y,
-                                        const std::vector<GiNaC::symbol>& yd) {
-  const std::vector<Step> steps = build_steps(model, prog, y, yd);
-  const std::size_t f = y.size(), ns = steps.size();
-  const bool quadratic = model.inertial_velocity_terms();
-  LinkFrameProjection out;
-  out.M = crba(prog, steps, composite_inertias(prog, steps), f);
+namespace {
 
-  // Forward: velocities v and bias accelerations a (ÿ = 0); gravity is not here (header).
-  const Spatial base;
+// k − q of the inertia (RNEA) with the base accelerating at `base` (world axes): zero, or −g for
+// a uniform gravity field g, which the body wrenches I a + v ×* I v then include.
+std::vector<ex> rnea(Program& prog, const std::vector<Step>& steps, const std::vector<GiNaC::symbol>& y,
+                     const std::vector<GiNaC::symbol>& yd, bool quadratic, const Spatial& base) {
+  const std::size_t f = y.size(), ns = steps.size();
+  // Forward: velocities v and bias accelerations a (ÿ = 0).
   std::vector<Spatial> v(ns), a(ns), F(ns);
   for (std::size_t n = 0; n < ns; ++n) {
     const Step& step = steps[n];
@@ -343,16 +340,36 @@ LinkFrameProjection project_link_frames(const Model& model, Program& prog,
       F[n] = apply(steps[n].I, a[n]);
       if (quadratic) F[n] = add(F[n], cross_force(v[n], define(prog, apply(steps[n].I, v[n]))));
     }
-  out.residual.assign(f, 0);
+  std::vector<ex> residual(f, 0);
   for (std::size_t n = ns; n-- > 0;) {
     F[n] = define(prog, F[n]);
-    for (const auto& [k, s] : steps[n].columns) out.residual[k] += dot(s, F[n]);
+    for (const auto& [k, s] : steps[n].columns) residual[k] += dot(s, F[n]);
     if (steps[n].parent >= 0) {
       const auto up = static_cast<std::size_t>(steps[n].parent);
       F[up] = add(F[up], force_to_parent(steps[n], F[n]));
     }
   }
+  return residual;
+}
+
+}  // namespace
+
+LinkFrameProjection project_link_frames(const Model& model, Program& prog,
+                                        const std::vector<GiNaC::symbol>& y,
+                                        const std::vector<GiNaC::symbol>& yd) {
+  const std::vector<Step> steps = build_steps(model, prog, y, yd);
+  LinkFrameProjection out;
+  out.M = crba(prog, steps, composite_inertias(prog, steps), y.size());
+  // Gravity is not here (header).
+  out.residual = rnea(prog, steps, y, yd, model.inertial_velocity_terms(), Spatial{});
   return out;
+}
+
+std::vector<ex> link_frame_residual_with_gravity(const Model& model, Program& prog,
+                                                 const std::vector<GiNaC::symbol>& y,
+                                                 const std::vector<GiNaC::symbol>& yd, const Vec3& g) {
+  const std::vector<Step> steps = build_steps(model, prog, y, yd);
+  return rnea(prog, steps, y, yd, model.inertial_velocity_terms(), Spatial{zero_vec3(), scale(-1, g)});
 }
 
 }  // namespace mbsgen

@@ -17,9 +17,11 @@
 // (Featherstone, Rigid Body Dynamics Algorithms, 2008, §4.4 for c_J = ∘S ẏ + v × v_J, §5.3 RNEA,
 // §6.2 CRBA.) Gravity and applied forces at markers are not included: they are projected in the
 // world frame (dynamics.cpp), the residual being linear in the wrenches. Gravity as the base
-// acceleration −g costs fewer operations (6-link spatial chain: residual 1093 against 1464), but
+// acceleration −g costs fewer operations (6-link spatial chain: residual 1,095 against 1,466), but
 // the gravity stiffness then nests rotations down and back up the chain, and the proof that K
 // is symmetric for every y0 (structural_zeros.hpp) exceeds its budget: 132 exact zeros of N lost.
+// So the linearization differentiates the world-frame form, and only the residual and dynamics
+// kernels, evaluated and never differentiated, take the other (link_frame_residual_with_gravity).
 #pragma once
 
 #include "mbsgen/generator/kinematics.hpp"
@@ -56,5 +58,13 @@ bool prefers_link_frames(const Model& model);
 LinkFrameProjection project_link_frames(const Model& model, Program& program,
                                         const std::vector<GiNaC::symbol>& y,
                                         const std::vector<GiNaC::symbol>& yd);
+
+/// The inertial residual of `model` with a uniform gravity field g included as the base's
+/// acceleration −g (Featherstone 2008, §5.3): k − q of inertia and gravity, the same function as
+/// project_link_frames' residual plus gravity projected in the world frame, in fewer operations
+/// (dynamics.hpp, Equations::residual_kernel).
+std::vector<GiNaC::ex> link_frame_residual_with_gravity(const Model& model, Program& program,
+                                                        const std::vector<GiNaC::symbol>& y,
+                                                        const std::vector<GiNaC::symbol>& yd, const Vec3& g);
 
 }  // namespace mbsgen
