@@ -163,13 +163,15 @@ def main():
             for _ in range(max(1, args.generate_runs)):
                 shutil.rmtree(parts, ignore_errors=True)
                 runs.append(measured([args.mbsgen, "generate", model, "--out", parts, "--parts", str(2 * args.jobs)]))
-            rc = max(r[0] for r in runs)
+                if runs[-1][0] != 0:
+                    break  # a failure (a signal gives a negative code) is the row's status
+            rc = runs[-1][0]
             wall = statistics.median(r[1] for r in runs)
             cpu = statistics.median(r[2] for r in runs)
             peak = max(r[3] for r in runs)
             ops = operation_counts(os.path.join(parts, model_id + ".cpp"))
             rows.append(dict(row, variant="generate", status="ok" if rc == 0 else "failed", wall_s=wall, cpu_s=cpu,
-                             peak_mb=peak / 1024, ops_mass_matrix=ops.get("mass_matrix"),
+                             peak_mb=peak / 1024, runs=len(runs), ops_mass_matrix=ops.get("mass_matrix"),
                              ops_residual=ops.get("residual"), ops_linear=ops.get("linear"),
                              ops_total=sum(v for k, v in ops.items() if k != "linear_structured")))
             # The level mbsgen run takes (generator/tool/run.cpp, parts_level).
@@ -199,7 +201,7 @@ def main():
             shutil.rmtree(parts, ignore_errors=True)
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    fields = ["links", "coordinates", "variant", "status", "wall_s", "cpu_s", "peak_mb", "ops_mass_matrix",
+    fields = ["links", "coordinates", "variant", "status", "wall_s", "cpu_s", "peak_mb", "runs", "ops_mass_matrix",
               "ops_residual", "ops_linear", "ops_total", "mass_matrix_s", "residual_s", "linear_s",
               "mass_matrix_checksum", "residual_checksum", "linear_checksum"]
     with open(os.path.join(args.out, "compile_scale.csv"), "w", newline="") as f:

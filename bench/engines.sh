@@ -56,17 +56,24 @@ ver() { dpkg-query -W -f='${Version}' "$1" 2>/dev/null || echo "?"; }
   echo "orocos_kdl: $(ver liborocos-kdl-dev)"
 } >>"$out/system.txt"
 if [ -z "$processes" ]; then processes=5; [ ${#quick[@]} -gt 0 ] && processes=1; fi
-case "$processes" in ''|*[!0-9]*|0) echo "engines: --processes wants a positive integer" >&2; exit 2 ;; esac
+case "$processes" in ''|*[!0-9]*) echo "engines: --processes wants a positive integer" >&2; exit 2 ;; esac
+if (( 10#$processes < 1 )); then echo "engines: --processes wants a positive integer" >&2; exit 2; fi
 runs=()
-rm -rf "$out/engines_runs"
-for k in $(seq 1 "$processes"); do
+# Nothing of an earlier run may pass for this one's (report_engines.py reads these).
+rm -rf "$out/engines_runs" "$out/engines.csv" "$out/engines_agreement.csv" "$out/engines_mjcf"
+: >"$out/engines.log"
+for k in $(seq 1 "$((10#$processes))"); do
   log "MuJoCo and KDL against our kernels ${quick[*]:-} (process $k of $processes)"
-  mkdir -p "$out/engines_runs/$k"
-  "$build/bench/engines_bench" "$out/engines_runs/$k" "${quick[@]}" 2>"$out/engines.log" || {
-    tail -30 "$out/engines.log" >&2
+  run="$out/engines_runs/$k"
+  mkdir -p "$run"
+  if ! "$build/bench/engines_bench" "$run" "${quick[@]}" 2>"$run/engines.log"; then
+    cat "$run/engines.log" >>"$out/engines.log"
+    cp "$run/engines_agreement.csv" "$out/engines_agreement.csv" 2>/dev/null || true
+    tail -30 "$run/engines.log" >&2
     exit 1
-  }
-  runs+=("$out/engines_runs/$k/engines.csv")
+  fi
+  { echo "== process $k"; cat "$run/engines.log"; } >>"$out/engines.log"
+  runs+=("$run/engines.csv")
 done
 cp "$out/engines_runs/1/engines_agreement.csv" "$out/engines_agreement.csv"
 rm -rf "$out/engines_mjcf"

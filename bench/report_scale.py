@@ -28,14 +28,15 @@ def section(results, table, ftime):
     by = {}
     for r in rows:
         by.setdefault(int(r["links"]), {})[r["variant"]] = r
+    runs = next((r.get("runs") or "1" for r in rows if r["variant"] == "generate"), "1")
     out = ["### Large models: the cost before the first answer", "",
            "The N-link spatial chain (`bench/spatial_chain_model.py`, 2N coordinates, universal joints), "
            "by `bench/compile_scale.py`: **run** = `mbsgen run MODEL -- modes` with an empty solver cache "
            "(generation, the kernels longer than 20,000 operations cut into parts of 5,000, compiled by %s compilers at once — "
            "parts at -O2 up to 100,000 operations in all kernels, else at -O1, the rest at -O2 —, linking, the first eigenvalues), its wall and CPU time and the peak "
-           "memory of all its processes together; **generate** = `mbsgen generate` alone (median of 3 runs, their largest peak); ops = operations of "
+           "memory of all its processes together; **generate** = `mbsgen generate` alone (median of %s runs, their largest peak); ops = operations of "
            "mass_matrix + residual + linear + outputs + bodies (linear_structured calls linear); **kernels "
-           "compiled** = the generated files compiled as a shared library the same way." % "2", ""]
+           "compiled** = the generated files compiled as a shared library the same way." % ("2", runs), ""]
     t = []
     for n in sorted(by):
         v = by[n]

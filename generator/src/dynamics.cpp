@@ -329,7 +329,10 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
       add_gravity_wrenches(model, kin, world);
       project_wrenches(eq, world);
       // The kernels' form: gravity as the base's acceleration (Equations::residual_kernel).
-      if (!model.gravity().empty() && !has_reactions(original)) {
+      // (Not for reactions' joint probes, nor where loops or velocity constraints rebuild the
+      // kernels from `residual`: derive() would clear it.)
+      if (!model.gravity().empty() && !has_reactions(original) && model.constraints().empty() &&
+          model.velocity_constraints().empty()) {
         Vec3 g = zero_vec3();
         for (const auto& field : model.gravity()) g = add(g, field.g);
         eq.residual_kernel = link_frame_residual_with_gravity(model, prog, eq.y, eq.yd, g);

@@ -483,21 +483,30 @@ std::string structured_from_linear(const std::string& id, const Kernel& k, const
   return c.str();
 }
 
-// The generated file's finiteness check of a kernel's outputs. x·0 is ±0 for a finite x and NaN
-// for an infinite or NaN one, so the OR of the products' bits has every exponent bit set exactly
-// when some x is not finite. Without the branch of an isfinite loop, GCC vectorizes it at -O2: the
-// check of a 24×24 mass matrix went from 210 to 150 ns of a 1.2 µs kernel (issue 17).
-const char* const kAllFinite = R"(// Whether x[0..n) are all finite (x·0 is ±0 for a finite x, NaN otherwise).
+// The generated file's finiteness check of a kernel's outputs, branch-free so that the compiler
+// vectorizes it (GCC -O2 does: two lanes of 64 bits), with integer operations only so that it
+// raises no floating-point exception (x·0, the first form, raised FE_INVALID for an infinity).
+// The std::isfinite loop it replaces took 210 of the 1,200 ns of the 12-link chain's mass matrix
+// (576 entries); with this one the kernel takes 1.13 instead of 1.21 µs (throwaway driver,
+// 2026-11-27).
+const char* const kAllFinite = R"(// Whether x[0..n) are all finite: an exponent field of all ones (infinity, NaN) is the one that
+// carries into the sign bit when 1 is added to it. Integer operations only, no branch.
 bool all_finite(const double* x, int n) {
-  unsigned long long bits = 0;
-  for (int i = 0; i < n; ++i) {
-    const double zero_or_nan = x[i] * 0.0;
+  const unsigned long long exponent = 0x7ff0000000000000ull, one = 0x0010000000000000ull;
+  unsigned long long carries[4] = {0, 0, 0, 0};
+  int i = 0;
+  for (; i + 4 <= n; i += 4)
+    for (int k = 0; k < 4; ++k) {
+      unsigned long long b;
+      std::memcpy(&b, x + i + k, sizeof b);
+      carries[k] |= (b & exponent) + one;
+    }
+  for (; i < n; ++i) {
     unsigned long long b;
-    std::memcpy(&b, &zero_or_nan, sizeof b);
-    bits |= b;
+    std::memcpy(&b, x + i, sizeof b);
+    carries[0] |= (b & exponent) + one;
   }
-  const unsigned long long exponent = 0x7ff0000000000000ull;
-  return (bits & exponent) != exponent;
+  return ((carries[0] | carries[1] | carries[2] | carries[3]) >> 63) == 0;
 }
 )";
 

@@ -28,7 +28,7 @@ struct Equations {
   std::vector<GiNaC::ex> residual;          ///< k(y, ẏ) − q(y, ẏ, u), length f
   /// The same k − q written for evaluation, or empty when `residual` is that form: on the link-
   /// frame route with gravity, the residual and dynamics kernels take gravity as the base's
-  /// acceleration (link_frame_residual_with_gravity: 12-link spatial chain 3,213 → 2,512
+  /// acceleration (link_frame_residual_with_gravity: 12-link spatial chain 3,213 → 2,346
   /// operations), while `residual`, which the linearization differentiates, keeps it projected in
   /// the world frame, the form whose exact zeros of N the proofs reach (link_frame_dynamics.hpp).
   /// Only for trees without reaction outputs; cleared when loops are closed.
