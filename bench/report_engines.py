@@ -101,12 +101,15 @@ def engines_section(results):
         "process of the same binary runs the 12-link kernels about 10 %% faster or slower than the next, "
         "whatever it does, as memory placement falls (`bench/engines_merge.py`). Before timing, the three must agree to 1e-12 "
         "(largest difference over largest entry, over the states; *agreement* is the worst pair). "
-        "*ratio* = fastest engine / ours: above 1 we are faster."
+        "*ratio* = fastest engine / ours: above 1 we are faster; *of minima* = the same from each one's "
+        "fastest batch (over all processes), which other tenants of the host slow least (in this session's "
+        "runs they slowed MuJoCo's 12-link M by up to 50 %%, ours by up to 15 %%). The goal is called met only "
+        "where both ratios meet it."
         % (system.get("mujoco", "?"), system.get("orocos_kdl", "?"), rows[0].get("repetitions", "?"),
            rows[0].get("processes", "1")),
         "",
-        "| model | coords | quantity | ours | ops (ours) | MuJoCo | KDL | ratio | agreement |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| model | coords | quantity | ours | ops (ours) | MuJoCo | KDL | ratio | of minima | agreement |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     verdict = []
     for model, n, coords in models:
@@ -123,18 +126,23 @@ def engines_section(results):
             fastest = min(x for x in (mj, kdl_best) if math.isfinite(x)) if math.isfinite(mj) or math.isfinite(kdl_best) else math.nan
             o = _num(ours["median_ns"])
             ratio = fastest / o if o > 0 else math.nan
+            minima = [_num(t[(model, n, e, q)]["min_ns"]) for e in ("mujoco", "kdl", "kdl_rne") if (model, n, e, q) in t]
+            minima = [x for x in minima if math.isfinite(x)]
+            o_min = _num(ours.get("min_ns"))
+            ratio_min = min(minima) / o_min if minima and o_min > 0 else math.nan
             if q == "M+bias":  # the pairs of M and of bias, and our dynamics kernel's against the engines
                 a = max(agree.get((model, n, "M"), math.nan), agree.get((model, n, "bias"), math.nan),
                         agree.get((model, n, "M+bias"), 0.0))
             else:
                 a = agree.get((model, n, q), math.nan)
-            lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s |"
+            lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |"
                          % (_label(model, n), coords, q, _ns(o), ours.get("ops") or "–", _ns(mj), kdl_text,
-                            _ratio(ratio), "%.1e" % a if math.isfinite(a) else "–"))
+                            _ratio(ratio), _ratio(ratio_min), "%.1e" % a if math.isfinite(a) else "–"))
             if model == "spatial_chain" and math.isfinite(ratio):
                 need = GOAL_RATIO if int(n) <= GOAL_N else 1.0
-                if ratio < need:
-                    verdict.append("N = %s %s: %s (goal ≥ %s)" % (n, q, _ratio(ratio), _ratio(need)))
+                worse = min(ratio, ratio_min) if math.isfinite(ratio_min) else ratio
+                if worse < need:
+                    verdict.append("N = %s %s: %s (goal ≥ %s)" % (n, q, _ratio(worse), _ratio(need)))
     lines.append("")
     if verdict:
         lines.append("**Goal** (ours ≥ 3× faster than the fastest engine for N ≤ 12, never slower up to N = 30) "
