@@ -7,6 +7,7 @@
 #include "mbsgen/generator/escape.hpp"
 #include "mbsgen/generator/output_files.hpp"
 
+#include "child_task.hpp"
 #include "emit_chunks.hpp"
 #include "type_test.hpp"
 
@@ -14,9 +15,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
@@ -287,7 +290,8 @@ std::string zeros_at_operating_point(const Kernel& k) {
 
 // The statements of a kernel: the intermediates its outputs need (in definition order), the
 // outputs, and the operating point's values for its test (`const double op<i>`); then CSE.
-std::vector<Statement> kernel_statements(const Kernel& k, Program& prog, bool cse) {
+// Which of the program's definitions the kernel's outputs and operating point test need.
+std::vector<char> needed_definitions(const Kernel& k, const Program& prog) {
   std::vector<char> needed(prog.definitions().size(), 0);
   std::vector<ex> stack;
   for (const auto& b : k.outputs)
@@ -306,6 +310,11 @@ std::vector<Statement> kernel_statements(const Kernel& k, Program& prog, bool cs
     }
     for (std::size_t i = 0; i < e.nops(); ++i) stack.push_back(e.op(i));
   }
+  return needed;
+}
+
+std::vector<Statement> kernel_statements(const Kernel& k, Program& prog, bool cse) {
+  const std::vector<char> needed = needed_definitions(k, prog);
   std::vector<Statement> statements;
   for (std::size_t i = 0; i < needed.size(); ++i)
     if (needed[i]) {
@@ -889,10 +898,10 @@ std::string manifest_json(const Model& model, const Equations& eq, const LinearE
   return j.str();
 }
 
-// mass_matrix, residual, linear and linear_structured: the second-order model's kernels.
-void second_order_kernels(Equations& eq, const LinearEquations& lin, const std::vector<ex>& y, const std::vector<ex>& yd,
-                          const std::vector<ex>& p, bool dynamics, std::vector<Kernel>& kernels) {
-  const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
+// mass_matrix, residual and (asked for) dynamics: the second-order model's kernels that need only
+// the derivation (emit_ahead emits them while the caller linearizes). f: the coordinates.
+void derivation_kernels(const Equations& eq, const std::vector<ex>& y, const std::vector<ex>& yd, const std::vector<ex>& p,
+                        std::size_t f, bool dynamics, std::vector<Kernel>& kernels) {
   const std::vector<ex> u(eq.u.begin(), eq.u.end());
   kernels.push_back({"mass_matrix", "M(y, p): f×f mass matrix, column-major",
                      {{"y", y}, {"p", p}},
@@ -906,6 +915,13 @@ void second_order_kernels(Equations& eq, const LinearEquations& lin, const std::
     kernels.push_back({"dynamics", "M(y) (f×f, column-major) and k − q (length f) in one kernel (EmitOptions::dynamics)",
                        {{"y", y}, {"yd", yd}, {"u", u}, {"p", p}},
                        {{"M", column_major(eq.M, f, f), ""}, {"r", residual, ""}}});
+}
+
+// mass_matrix, residual, linear and linear_structured: the second-order model's kernels.
+void second_order_kernels(Equations& eq, const LinearEquations& lin, const std::vector<ex>& y, const std::vector<ex>& yd,
+                          const std::vector<ex>& p, bool dynamics, std::vector<Kernel>& kernels) {
+  const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
+  derivation_kernels(eq, y, yd, p, f, dynamics, kernels);
   std::vector<ex> none;
   kernels.push_back({"linear",
                      "linearized M, Q, K (f×f), B (f×m), C_y, C_v (r×f) at (y0, yd0), column-major",
@@ -968,6 +984,33 @@ Kernel reduced_kernel(Equations& eq, const LinearEquations& lin, const std::vect
            {"B", column_major(r.B, n, m), ""}}};
 }
 
+// bodies: the kinematics of each of the nb bodies (f coordinates).
+Kernel bodies_kernel(const Equations& eq, std::size_t nb, const std::vector<ex>& y, const std::vector<ex>& p, std::size_t f) {
+  std::vector<ex> rc, S, JT, JR, mass, Ic;
+  for (std::size_t i = 0; i < nb; ++i) {
+    const BodyKinematics& b = eq.kinematics.bodies[i];
+    for (int a = 0; a < 3; ++a) rc.push_back(b.com[a]);
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) S.push_back(b.S[a][c]);
+    mass.push_back(b.inertia.m);
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) Ic.push_back(b.I_com[a][c]);
+  }
+  for (std::size_t i = 0; i < nb; ++i)
+    for (std::size_t j = 0; j < f; ++j)
+      for (std::size_t a = 0; a < 3; ++a) {
+        JT.push_back(eq.JT[3 * i + a][j]);
+        JR.push_back(eq.JR[3 * i + a][j]);
+      }
+  return {"bodies",
+          "per body: centre of mass rc (3), rotation S (3×3), Jacobians JT, JR (3×f, "
+          "centre-of-mass velocity and angular velocity in the world frame), mass m and "
+          "inertia Ic about the centre of mass in the world frame (3×3)",
+          {{"y", y}, {"p", p}},
+          {{"rc", rc, ""}, {"S", S, ""}, {"JT", JT, ""}, {"JR", JR, ""},
+           {"m", mass, ""}, {"Ic", Ic, ""}}};
+}
+
 // The kernels of docs/generator.md, in emission order. With closed loops the coordinates y are
 // the tree's (n), the rates yd the independent ones, and the matrices those of the independent
 // coordinates (f); such kernels are wrapped (Kernel::wrapped).
@@ -1027,29 +1070,7 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
     kernels.push_back({"output_terms", "output rows C_a (r×f) and D (r×m) of z = C_y y + C_v yd + C_a ydd + D u, column-major",
                        {{"y0", y}, {"yd0", lin.at_rest ? std::vector<ex>{} : yd}, {"p", p}},
                        {{"Ca", column_major(lin.Ca, r, f), ""}, {"D", column_major(lin.Du, r, m), ""}}});
-  std::vector<ex> rc, S, JT, JR, mass, Ic;
-  for (std::size_t i = 0; i < nb; ++i) {
-    const BodyKinematics& b = eq.kinematics.bodies[i];
-    for (int a = 0; a < 3; ++a) rc.push_back(b.com[a]);
-    for (int c = 0; c < 3; ++c)
-      for (int a = 0; a < 3; ++a) S.push_back(b.S[a][c]);
-    mass.push_back(b.inertia.m);
-    for (int c = 0; c < 3; ++c)
-      for (int a = 0; a < 3; ++a) Ic.push_back(b.I_com[a][c]);
-  }
-  for (std::size_t i = 0; i < nb; ++i)
-    for (std::size_t j = 0; j < f; ++j)
-      for (std::size_t a = 0; a < 3; ++a) {
-        JT.push_back(eq.JT[3 * i + a][j]);
-        JR.push_back(eq.JR[3 * i + a][j]);
-      }
-  kernels.push_back({"bodies",
-                     "per body: centre of mass rc (3), rotation S (3×3), Jacobians JT, JR (3×f, "
-                     "centre-of-mass velocity and angular velocity in the world frame), mass m and "
-                     "inertia Ic about the centre of mass in the world frame (3×3)",
-                     {{"y", y}, {"p", p}},
-                     {{"rc", rc, ""}, {"S", S, ""}, {"JT", JT, ""}, {"JR", JR, ""},
-                      {"m", mass, ""}, {"Ic", Ic, ""}}});
+  kernels.push_back(bodies_kernel(eq, nb, y, p, f));
 
   if (loops)
     for (auto& k : kernels) k.wrapped = k.name != "operating_point";
@@ -1090,21 +1111,224 @@ void distribute_chunks(GeneratedCode& out, const std::vector<std::pair<std::stri
   }
 }
 
-GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin,
-                   const EmitOptions& options) {
-  GeneratedCode out;
+namespace {
+
+// The scene's selection, with every effect of the model for the full model.
+SceneSelection emitted_scene(const Model& model) {
   SceneSelection scene = model.selection();
-  if (!options.scene.empty() && options.scene != scene.name)
-    throw std::invalid_argument("mbsgen::emit: the model was pruned for scene '" + scene.name +
-                                "', not '" + options.scene + "' (apply_scene)");
   if (scene.full && scene.effects.empty()) scene.effects = effects_of(model);
+  return scene;
+}
+
+// The kernels' C identifier prefix (EmitOptions::id).
+std::string emitted_id(const Model& model, const EmitOptions& options) {
+  const SceneSelection& scene = model.selection();
   if (!options.id.empty() && !id_problem(options.id).empty())
     throw std::invalid_argument("mbsgen::emit: the id '" + options.id + "' " + id_problem(options.id));
   // A model name that C++ cannot use as a name (int, std) gets a final '_'.
-  out.id = identifier(!options.id.empty() ? options.id
-                      : scene.full     ? model.name()
-                                       : model.name() + "_" + scene.name);
-  if (reserved_identifier(out.id)) out.id += "_";
+  std::string id = identifier(!options.id.empty() ? options.id
+                              : scene.full     ? model.name()
+                                               : model.name() + "_" + scene.name);
+  if (reserved_identifier(id)) id += "_";
+  return id;
+}
+
+// The scene kernel each kernel comes with (SceneSelection::emits; dynamics: asked for, of the full
+// model only).
+std::string scene_kernel(const std::string& name) {
+  if (name == "outputs_general") return "outputs";
+  if (name == "dynamics") return "mass_matrix";
+  if (name == "output_terms" || name == "descriptor" || name == "reduced" || name == "reduced_parts") return "linear";
+  return name;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Kernels emitted ahead (emit_ahead), in a child process: their code comes back as a string.
+
+void put(std::string& s, std::size_t n) { s.append(reinterpret_cast<const char*>(&n), sizeof n); }
+void put(std::string& s, const std::string& text) {
+  put(s, text.size());
+  s += text;
+}
+
+void put(std::string& s, const EmittedKernel& k) {
+  put(s, k.code);
+  put(s, k.info.name);
+  put(s, k.info.signature);
+  put(s, k.info.operations);
+  put(s, k.chunks.definitions.size());
+  for (const auto& d : k.chunks.definitions) put(s, d);
+  for (std::size_t n : k.chunks.operations) put(s, n);
+  put(s, k.chunks.declarations);
+  put(s, k.chunks.calls);
+  put(s, k.chunks.workspace);
+}
+
+// Reads what put() wrote; ok turns false (and stays) at the first read past the end.
+struct Reader {
+  const std::string& s;
+  std::size_t at = 0;
+  bool ok = true;
+
+  std::size_t number() {
+    std::size_t n = 0;
+    if (!ok || s.size() - at < sizeof n) return ok = false, 0;
+    std::memcpy(&n, s.data() + at, sizeof n);
+    at += sizeof n;
+    return n;
+  }
+  std::string text() {
+    const std::size_t n = number();
+    if (!ok || s.size() - at < n) return ok = false, std::string();
+    std::string t = s.substr(at, n);
+    at += n;
+    return t;
+  }
+  EmittedKernel kernel() {
+    EmittedKernel k;
+    k.code = text();
+    k.info.name = text();
+    k.info.signature = text();
+    k.info.operations = number();
+    const std::size_t chunks = number();
+    for (std::size_t c = 0; ok && c < chunks; ++c) k.chunks.definitions.push_back(text());
+    for (std::size_t c = 0; ok && c < chunks; ++c) k.chunks.operations.push_back(number());
+    k.chunks.declarations = text();
+    k.chunks.calls = text();
+    k.chunks.workspace = number();
+    return k;
+  }
+};
+
+std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
+  h ^= v + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+  return h * 0xbf58476d1ce4e5b9ULL;
+}
+
+// A hash of a kernel: its name, arguments and outputs, and the definitions they need, with
+// GiNaC's hashes of the expressions. A child that derived from the caller's state (emit_ahead)
+// made the same symbols with the same hashes: a kernel emitted there is taken only when the
+// caller's has the same fingerprint.
+std::uint64_t fingerprint(const Kernel& k, const Program& prog) {
+  const std::hash<std::string> text;
+  std::uint64_t h = mix(text(k.name), text(k.doc));
+  h = mix(mix(h, k.wrapped), mix(k.internal, text(k.computed_by)));
+  for (const auto& a : k.inputs) {
+    h = mix(h, text(a.name));
+    for (const ex& s : a.symbols) h = mix(h, s.gethash());
+  }
+  for (const auto& b : k.outputs) {
+    h = mix(mix(h, text(b.name)), b.zero_at_op.size());
+    for (const ex& v : b.values) h = mix(h, v.gethash());
+    for (char z : b.zero_at_op) h = mix(h, static_cast<std::uint64_t>(z));
+  }
+  for (const ex& v : k.at_op.values) h = mix(h, v.gethash());
+  const std::vector<char> needed = needed_definitions(k, prog);
+  for (std::size_t i = 0; i < needed.size(); ++i)
+    if (needed[i]) h = mix(mix(h, i), mix(prog.definitions()[i].symbol.gethash(), prog.definitions()[i].value.gethash()));
+  return h;
+}
+
+// The kernels emit_ahead emits: those of the scene that need only the derivation; none for a
+// model with closed loops (its kernels are wrapped) or rolling constraints (whose kernels are the
+// linearization's descriptor form).
+std::vector<Kernel> derivation_only_kernels(const Model& model, const Equations& eq, const EmitOptions& options) {
+  if (eq.loops.active || eq.nonholonomic.active) return {};
+  const SceneSelection scene = emitted_scene(model);
+  const std::vector<ex> y(eq.y.begin(), eq.y.end()), yd(eq.yd.begin(), eq.yd.end()), p(eq.p.begin(), eq.p.end());
+  std::vector<Kernel> all, kernels;
+  derivation_kernels(eq, y, yd, p, eq.y.size(), options.dynamics && scene.full, all);
+  all.push_back(bodies_kernel(eq, model.bodies().size(), y, p, eq.y.size()));
+  for (Kernel& k : all)
+    if (scene.emits(scene_kernel(k.name))) kernels.push_back(std::move(k));
+  return kernels;
+}
+
+}  // namespace
+
+struct KernelsAhead::State {
+  std::string id;
+  EmitOptions options;
+  std::unique_ptr<detail::ChildTask> task;
+  std::vector<std::pair<std::uint64_t, EmittedKernel>> emitted;  // with their fingerprints
+  std::size_t taken = 0;
+};
+
+KernelsAhead::KernelsAhead() = default;
+KernelsAhead::KernelsAhead(KernelsAhead&&) noexcept = default;
+KernelsAhead& KernelsAhead::operator=(KernelsAhead&&) noexcept = default;
+KernelsAhead::~KernelsAhead() = default;
+bool KernelsAhead::started() const { return state_ != nullptr; }
+std::size_t KernelsAhead::taken() const { return state_ ? state_->taken : 0; }
+
+KernelsAhead emit_ahead(const Model& model, const EmitOptions& options) {
+  KernelsAhead ahead;
+  if ((!options.id.empty() && !id_problem(options.id).empty()) ||
+      (!options.scene.empty() && options.scene != model.selection().name))
+    return ahead;  // emit() reports these
+  auto state = std::make_unique<KernelsAhead::State>();
+  state->id = emitted_id(model, options);
+  state->options = options;
+  const KernelsAhead::State& st = *state;
+  // The child derives the model itself: forked before the caller's derivation, it shares almost
+  // no memory with it. Forked after, each process's first write to a shared page (GiNaC's
+  // reference counts are in every node) copied the page, and the caller's linearization took a
+  // third longer while the child ran (40-link chain: 3.0 → 4.1 s).
+  state->task = detail::ChildTask::start([&model, &st] {
+    Equations eq = derive(model);
+    const std::vector<Kernel> kernels = derivation_only_kernels(model, eq, st.options);
+    std::string out;
+    put(out, kernels.size());
+    for (const Kernel& k : kernels) {
+      put(out, fingerprint(k, eq.program));
+      put(out, emit_kernel(st.id, k, eq.program, st.options.cse, st.options.chunk_operations));
+    }
+    return out;
+  });
+  if (state->task) ahead.state_ = std::move(state);
+  return ahead;
+}
+
+namespace {
+
+// Kernel k as emitted ahead, when it was, with the same options and fingerprint.
+std::optional<EmittedKernel> emitted_ahead(KernelsAhead::State* ahead, const Kernel& k, const Program& prog,
+                                           const std::string& id, const EmitOptions& options) {
+  if (!ahead || ahead->id != id || ahead->options.cse != options.cse ||
+      ahead->options.chunk_operations != options.chunk_operations)
+    return std::nullopt;
+  if (ahead->task) {  // the first kernel asked for: the child's result
+    const std::optional<std::string> result = ahead->task->result();
+    ahead->task.reset();
+    if (result) {
+      Reader r{*result};
+      std::vector<std::pair<std::uint64_t, EmittedKernel>> emitted;
+      const std::size_t n = r.number();
+      for (std::size_t i = 0; r.ok && i < n; ++i) {
+        const std::uint64_t f = r.number();
+        emitted.emplace_back(f, r.kernel());
+      }
+      if (r.ok && r.at == result->size()) ahead->emitted = std::move(emitted);
+    }
+  }
+  for (auto& [f, e] : ahead->emitted)
+    if (e.info.name == k.name && f == fingerprint(k, prog)) {
+      ++ahead->taken;
+      return e;
+    }
+  return std::nullopt;
+}
+
+}  // namespace
+
+GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin, const EmitOptions& options,
+                   KernelsAhead* ahead) {
+  GeneratedCode out;
+  const SceneSelection scene = emitted_scene(model);
+  if (!options.scene.empty() && options.scene != scene.name)
+    throw std::invalid_argument("mbsgen::emit: the model was pruned for scene '" + scene.name +
+                                "', not '" + options.scene + "' (apply_scene)");
+  out.id = emitted_id(model, options);
   const bool loops = eq.loops.active;
   const std::size_t n = eq.y.size();
   if (options.dynamics && (lin.descriptor || !model.selection().full))
@@ -1128,14 +1352,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   }
   bool split_needed = false;
   for (const auto& k0 : kernels) {
-    // The scene kernel each one comes with (dynamics: asked for, of the full model only).
-    const std::string as = k0.name == "outputs_general"                          ? "outputs"
-                           : k0.name == "dynamics"                               ? "mass_matrix"
-                           : k0.name == "output_terms" || k0.name == "descriptor" || k0.name == "reduced" ||
-                                     k0.name == "reduced_parts"
-                               ? "linear"
-                                                                                : k0.name;
-    if (!scene.emits(as)) continue;
+    if (!scene.emits(scene_kernel(k0.name))) continue;
     Kernel k = k0;
     if (k.computed_by == "linear") {
       if (!scene.emits("linear"))
@@ -1144,7 +1361,9 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
       k.computed_by_operations += out.kernels.back().operations;  // linear's, emitted just before
       split_needed = true;
     }
-    EmittedKernel ek = emit_kernel(out.id, k, eq.program, options.cse, options.chunk_operations);
+    std::optional<EmittedKernel> early =
+        emitted_ahead(ahead ? ahead->state_.get() : nullptr, k, eq.program, out.id, options);
+    EmittedKernel ek = early ? std::move(*early) : emit_kernel(out.id, k, eq.program, options.cse, options.chunk_operations);
     if (!ek.chunks.definitions.empty()) {
       kernel_code << "namespace " << out.id << "_kernel_parts {\n" << ek.chunks.declarations << "}\n\n";
       for (std::size_t c = 0; c < ek.chunks.definitions.size(); ++c)

@@ -181,6 +181,16 @@ int main(int argc, char** argv) try {
     mbsgen::tool::Progress progress(*check ? "check" : *info ? "info" : "generate");
     mbsgen::Model model = mbsgen::read_model_file(model_file);
     const mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
+    mbsgen::EmitOptions options;
+    options.cse = !no_cse;
+    options.dynamics = dynamics;
+    options.parts = parts;
+    options.chunk_operations = part_operations;
+    options.source_file = model_file;
+    options.id = id;
+    // The kernels that need only the derivation, on the second core while this one linearizes.
+    mbsgen::KernelsAhead ahead;
+    if (!*check) ahead = progress.paused([&] { return mbsgen::emit_ahead(pruned, options); });
     progress.stage("deriving the equations");
     mbsgen::Equations& eq = mbsgen::tool::kept_until_exit<mbsgen::Equations>([&] { return mbsgen::derive(pruned); });
     for (const auto& [e, why] : eq.loops.dropped)
@@ -199,14 +209,7 @@ int main(int argc, char** argv) try {
                 << model.coordinates().size() << " coordinates)\n";
       return 0;
     }
-    mbsgen::EmitOptions options;
-    options.cse = !no_cse;
-    options.dynamics = dynamics;
-    options.parts = parts;
-    options.chunk_operations = part_operations;
-    options.source_file = model_file;
-    options.id = id;
-    mbsgen::GeneratedCode code = mbsgen::emit(pruned, eq, lin, options);
+    mbsgen::GeneratedCode code = mbsgen::emit(pruned, eq, lin, options, &ahead);
     progress.stop();
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (*info) return print_info(pruned, model.scenes(), eq, lin, code, seconds);

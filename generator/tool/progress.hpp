@@ -40,6 +40,14 @@ class Progress {
     detail_ = std::move(text);
   }
 
+  /// f() run while the thread is not writing: a child process forked meanwhile (emit_ahead)
+  /// inherits no lock the thread held.
+  template <class F>
+  auto paused(F f) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return f();
+  }
+
   /// Stops the thread and erases the line; call before writing anything else to stderr.
   void stop() {
     if (!thread_.joinable()) return;

@@ -294,6 +294,14 @@ bool build_solver(const std::string& model_file, const std::string& scene, const
                   const Toolchain& tc, const fs::path& dir, Progress& progress) {
   const Model full = read_model_file(model_file);
   const Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
+  const std::size_t parallel = parallel_jobs();
+  EmitOptions options;
+  options.scene = scene;
+  options.source_file = model_file;
+  options.id = "model";
+  options.parts = 2 * parallel;
+  // The kernels that need only the derivation, on the second core while this one linearizes.
+  KernelsAhead ahead = progress.paused([&] { return emit_ahead(model, options); });
   progress.stage("deriving the equations");
   Equations& eq = kept_until_exit<Equations>([&] { return derive(model); });
   progress.stage("linearizing");
@@ -301,13 +309,7 @@ bool build_solver(const std::string& model_file, const std::string& scene, const
   progress.stage("checking the operating point");
   check_operating_point(eq, lin);
   progress.stage("emitting the kernels");
-  const std::size_t parallel = parallel_jobs();
-  EmitOptions options;
-  options.scene = scene;
-  options.source_file = model_file;
-  options.id = "model";
-  options.parts = 2 * parallel;
-  GeneratedCode code = emit(model, eq, lin, options);
+  GeneratedCode code = emit(model, eq, lin, options, &ahead);
   const auto& range = model.selection().frequency_range;
   GeneratedApi api = emit_api(model, lin, code, scene, range ? range->from_hz : 0.0, range ? range->to_hz : 0.0,
                               range ? range->points : 0, range ? !range->logarithmic : false);
