@@ -1,6 +1,7 @@
 #include "child_task.hpp"
 
 #include <sys/mman.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -8,6 +9,7 @@
 #include <cerrno>
 #include <csignal>
 #include <exception>
+#include <new>
 
 namespace mbsgen::detail {
 
@@ -44,13 +46,16 @@ std::optional<std::string> read_all(int fd) {
 std::unique_ptr<ChildTask> ChildTask::start(const std::function<std::string()>& work) {
   const int fd = ::memfd_create("mbsgen-child-result", MFD_CLOEXEC);
   if (fd < 0) return nullptr;
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fd);
     return nullptr;
   }
   if (pid == 0) {
-    // The child: exit status 0 only with the whole result written.
+    // The child: ends with its parent (which may be killed before it asks for the result), and
+    // exits with status 0 only with the whole result written.
+    if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) ::_exit(1);
     int status = 1;
     try {
       if (write_all(fd, work())) status = 0;
@@ -61,20 +66,27 @@ std::unique_ptr<ChildTask> ChildTask::start(const std::function<std::string()>& 
   return std::unique_ptr<ChildTask>(new ChildTask(pid, fd));
 }
 
-void ChildTask::reap() {
-  if (reaped_) return;
+bool ChildTask::reap() {
+  if (reaped_) return false;
   reaped_ = true;
   int status = 0;
-  while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+  pid_t r = 0;
+  while ((r = ::waitpid(pid_, &status, 0)) < 0 && errno == EINTR) {
   }
-  last_status_ = status;
+  // Anything but our child's own normal end is a failure (ECHILD where SIGCHLD is ignored, or
+  // where someone else's waitpid(-1) reaped it).
+  return r == pid_ && WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
 std::optional<std::string> ChildTask::result() {
   if (reaped_) return std::nullopt;
-  reap();
+  const bool ok = reap();
   std::optional<std::string> r;
-  if (WIFEXITED(last_status_) && WEXITSTATUS(last_status_) == 0) r = read_all(fd_);
+  try {
+    if (ok) r = read_all(fd_);
+  } catch (const std::bad_alloc&) {
+    r.reset();
+  }
   ::close(fd_);
   return r;
 }

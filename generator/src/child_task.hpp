@@ -23,9 +23,10 @@ class ChildTask {
  public:
   /// Runs work() in a child process, started at once; nullptr when no child can be started
   /// (fork or memfd_create failed): the caller then does the work itself. The child calls no
-  /// destructor and no exit handler of the parent's (it ends with _exit). In a process with
-  /// other threads only the caller's runs in the child: work() must not need a lock another
-  /// thread may hold at the fork.
+  /// destructor and no exit handler of the parent's (it ends with _exit), and is killed when
+  /// the parent ends. In a process with other threads only the caller's runs in the child:
+  /// work() must not need a lock another thread may hold at the fork (glibc resets its stdio and
+  /// malloc locks in the child; nothing else's).
   static std::unique_ptr<ChildTask> start(const std::function<std::string()>& work);
 
   ChildTask(const ChildTask&) = delete;
@@ -33,18 +34,18 @@ class ChildTask {
   /// Kills and reaps a child whose result was not asked for.
   ~ChildTask();
 
-  /// Waits for the child to end: work()'s result, or nothing when it threw, was killed or could
-  /// not write its result. Once only (later calls give nothing).
+  /// Waits for the child to end (without a time limit): work()'s result, or nothing when it
+  /// threw, was killed, could not write its result or was reaped by someone else. Once only
+  /// (later calls give nothing).
   std::optional<std::string> result();
 
  private:
   ChildTask(pid_t pid, int fd) : pid_(pid), fd_(fd) {}
-  void reap();
+  bool reap();  // true: the child ended with status 0
 
   pid_t pid_;
   int fd_;
   bool reaped_ = false;
-  int last_status_ = 0;  // waitpid's, once reaped
 };
 
 }  // namespace mbsgen::detail

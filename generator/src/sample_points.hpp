@@ -21,7 +21,8 @@ class SamplePoints {
  public:
   /// eq and lin must outlive this object; lin's operating point must not change meanwhile (the
   /// points at the operating point hold it).
-  SamplePoints(const Equations& eq, const LinearEquations& lin) : eq_(eq), lin_(lin) {}
+  SamplePoints(const Equations& eq, const LinearEquations& lin)
+      : eq_(eq), lin_(lin), tape_(std::make_shared<ProgramTape>(eq.program)) {}
 
   /// Values of `entries` at point `index` (0, 1, …) of the sequence from kSampleSeed, made by
   /// sample_point with at_operating_point. GiNaC::Digits must be PointEvaluator::kDigits.
@@ -31,7 +32,7 @@ class SamplePoints {
     Sequence& s = sequences_[at_operating_point];
     while (s.points.size() <= index) {
       const GiNaC::exmap values = sample_point(eq_, lin_, s.state, at_operating_point);
-      s.points.push_back(std::make_unique<PointEvaluator>(eq_.program, values));
+      s.points.push_back(std::make_unique<PointEvaluator>(tape_, values));
     }
     return s.points[index]->evaluate(entries);
   }
@@ -43,6 +44,7 @@ class SamplePoints {
   };
   const Equations& eq_;
   const LinearEquations& lin_;
+  std::shared_ptr<ProgramTape> tape_;  // the program compiled once for all points
   Sequence sequences_[2];  // by at_operating_point
 };
 

@@ -65,12 +65,12 @@ struct GeneratedCode {
   std::vector<KernelInfo> kernels;
 };
 
+class KernelsAhead;
+
 /// Emits the kernels model.selection().kernels of the derived and linearized model. The header
 /// defines `<id>_HAS_<KERNEL>` (e.g. `<id>_HAS_LINEAR`) for each emitted kernel and declares
 /// only those; the manifest lists the scene's analyses, effects, kernels with their operation
 /// counts, and whether D, G and N are structurally zero.
-class KernelsAhead;
-
 /// ahead: what emit_ahead started for this model and options, or nullptr.
 GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin,
                    const EmitOptions& options = {}, KernelsAhead* ahead = nullptr);
@@ -78,15 +78,18 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
 /// The kernels that need only the derivation (mass_matrix, residual, dynamics and bodies, those
 /// the scene emits), emitted in a child process while the caller derives and linearizes: pass it
 /// to emit(), which takes their code from it and emits the others. GiNaC cannot share
-/// expressions between threads; the child (fork) derives the model on its own, on the second
-/// core. The 40-link spatial chain's take 0.8 s of its generation's 5 s (issue 17 §1).
+/// expressions between threads; the child (fork) derives the model on its own, on a second
+/// processor (issue 17 §1; the times are in docs/generator.md). Peak memory is that of both
+/// processes: the child's is the derivation's and these kernels'.
 ///
 /// The code is the same, byte for byte, as emit() alone writes: emit() takes a kernel emitted
 /// ahead only when the caller's has the same fingerprint (its expressions and the definitions
-/// they need, by GiNaC's hashes, which the child made from the same state), and emits it itself
-/// where no child could be started (fork or memfd_create failed) or the child failed. A model
-/// with closed loops or rolling constraints has no such kernels. A KernelsAhead not passed to
-/// emit() kills its child when destroyed.
+/// they need, by GiNaC's hashes, which the child made from the same state, and its symbols'
+/// names), and emits it itself where no child could be started (fork or memfd_create failed,
+/// one processor) or the child failed. A model with closed loops or rolling constraints has no
+/// such kernels. emit() waits for the child at the first of these kernels (without a time limit)
+/// and stops a child whose result it did not take; a KernelsAhead not passed to emit() kills its
+/// child when destroyed.
 class KernelsAhead {
  public:
   KernelsAhead();
@@ -110,8 +113,7 @@ class KernelsAhead {
 /// Starts emitting ahead for model (already pruned to options.scene, as for emit()). Call it
 /// right before derive(model), with the options emit() will get: the child's derivation starts
 /// from the caller's state. In a process with other threads, none may hold a lock at the call
-/// that the child needs (the C library's are reset by fork; a thread writing to a C++ stream
-/// would hold its locale's).
+/// that the child needs (glibc resets only its stdio and malloc locks in the child).
 KernelsAhead emit_ahead(const Model& model, const EmitOptions& options = {});
 
 /// `<id>.hpp`, `<id>.cpp`, `<id>.json` in dir, for write_files (output_files.hpp).
