@@ -140,11 +140,11 @@ void linearize_tree(Equations& eq, LinearEquations& lin, std::size_t f) {  // f 
   for (std::size_t i = 0; i < f; ++i) {
     ex ri = prog.define(residual[i]);
     for (std::size_t j = 0; j < f; ++j) {
-      lin.Q[i][j] = at(prog.diff(ri, eq.yd[j]));
+      lin.Q[i][j] = prog.diff_at(ri, eq.yd[j], sub);
       // ∂/∂y commutes with setting ẏ = 0 and u = 0, which are independent of y.
       lin.K[i][j] = prog.diff(residual_at_rest[i], eq.y[j]);
     }
-    for (std::size_t j = 0; j < m; ++j) lin.B[i][j] = -at(prog.diff(ri, eq.u[j]));
+    for (std::size_t j = 0; j < m; ++j) lin.B[i][j] = -prog.diff_at(ri, eq.u[j], sub);
   }
   lin.Cy.assign(r, std::vector<ex>(f, 0));
   lin.Cv.assign(r, std::vector<ex>(f, 0));
@@ -152,12 +152,12 @@ void linearize_tree(Equations& eq, LinearEquations& lin, std::size_t f) {  // f 
   for (std::size_t i = 0; i < r; ++i) {
     ex zi = prog.define(outputs[i]);
     for (std::size_t j = 0; j < f; ++j) {
-      lin.Cy[i][j] = at(prog.diff(zi, eq.y[j]));
-      lin.Cv[i][j] = at(prog.diff(zi, eq.yd[j]));
+      lin.Cy[i][j] = prog.diff_at(zi, eq.y[j], sub);
+      lin.Cv[i][j] = prog.diff_at(zi, eq.yd[j], sub);
     }
     if (eq.ydd.empty()) continue;  // only reaction outputs depend on ÿ and u
-    for (std::size_t j = 0; j < f; ++j) Ca[i][j] = at(prog.diff(zi, eq.ydd[j]));
-    for (std::size_t j = 0; j < m; ++j) Du[i][j] = at(prog.diff(zi, eq.u[j]));
+    for (std::size_t j = 0; j < f; ++j) Ca[i][j] = prog.diff_at(zi, eq.ydd[j], sub);
+    for (std::size_t j = 0; j < m; ++j) Du[i][j] = prog.diff_at(zi, eq.u[j], sub);
   }
   for (std::size_t k = 0; k < f; ++k) lin.coordinates.push_back(k);
   if (loops) {

@@ -293,6 +293,47 @@ ex Program::substitute(const ex& e, Substitution& s) {
   return e.subs(m, GiNaC::subs_options::no_pattern);
 }
 
+ex Program::diff_at_intermediate(std::size_t k, std::size_t variable, Substitution& s) {
+  if (!((deps_[k][variable / 64] >> (variable % 64)) & 1u)) return 0;
+  const std::uint64_t key = static_cast<std::uint64_t>(k) * variables_.size() + variable;
+  if (auto it = s.diff_memo_.find(key); it != s.diff_memo_.end()) return it->second;
+  // dt_k/dx at the point = ∂f_k/∂x + Σ_j ∂f_k/∂t_j dt_j/dx, each factor at the point; a factor
+  // that vanishes there drops its term before dt_j/dx is formed.
+  const ChainFactors& factors = chain_factors(k);  // stable: owned by a unique_ptr
+  GiNaC::exvector terms;
+  for (const auto& [v, d] : factors.variables)
+    if (v == variable) terms.push_back(substitute(d, s));
+  for (const auto& [j, p] : factors.intermediates) {
+    const ex at = substitute(p, s);
+    if (at.is_zero()) continue;
+    const ex dt = diff_at_intermediate(j, variable, s);
+    if (!dt.is_zero()) terms.push_back(at * dt);
+  }
+  const ex d = define(GiNaC::add(terms));
+  s.diff_memo_.emplace(key, d);
+  return d;
+}
+
+ex Program::diff_at(const ex& e, const GiNaC::symbol& x, Substitution& s) {
+  const std::size_t var = variable(x, "diff_at");
+  if (isa<GiNaC::numeric>(e)) return 0;
+  if (isa<GiNaC::symbol>(e)) {
+    if (e.is_equal(x)) return 1;
+    if (const std::size_t* d = def_index_.find(e)) return diff_at_intermediate(*d, var, s);
+    return 0;
+  }
+  const ChainFactors factors = factors_of(e, static_cast<long>(var));
+  GiNaC::exvector terms;
+  for (const auto& [v, d] : factors.variables) terms.push_back(substitute(d, s));
+  for (const auto& [k, p] : factors.intermediates) {
+    const ex at = substitute(p, s);
+    if (at.is_zero()) continue;
+    const ex dt = diff_at_intermediate(k, var, s);
+    if (!dt.is_zero()) terms.push_back(at * dt);
+  }
+  return GiNaC::add(terms);
+}
+
 ex Program::inline_all(const ex& e) {
   std::vector<std::size_t> ts;
   collect_intermediates(e, ts);

@@ -101,3 +101,55 @@ TEST(PointEvaluator, AValueGivenForAnIntermediateIsUsedAndAPoleOrAnUnboundSymbol
 
 }  // namespace
 }  // namespace mbsgen
+
+namespace mbsgen {
+namespace {
+
+// Program::diff_at (the linearization's Q, B, C_y, C_v, C_a, D) against the derivative at a
+// general point substituted afterwards, as linearize formed them before: both evaluated at a
+// pseudo-random point with 50 digits, equal to 1e-40 of the largest (the roundings differ).
+TEST(Program, DiffAtEqualsTheGeneralDerivativeSubstituted) {
+  for (const std::string file : {"/models/robots/puma560.yaml", "/models/textbook/sleeping_top.yaml",
+                                 "/models/middle_ear/middle_ear.yaml", "/models/textbook/jeffcott_rotor.yaml"}) {
+    const Model model = read_model_file(kSourceDir + file);
+    Equations eq = derive(model);
+    // At rest, inputs zero; and, for a second substitution, the coordinates too.
+    GiNaC::exmap rest, zero;
+    for (const auto& s : eq.yd) rest[s] = zero[s] = 0;
+    for (const auto& s : eq.u) rest[s] = zero[s] = 0;
+    for (const auto& s : eq.y) zero[s] = 0;
+    for (const GiNaC::exmap* values : {&rest, &zero}) {
+      Program::Substitution at(*values), at_too(*values);
+      std::vector<ex> direct, afterwards;
+      for (const ex& r : eq.residual) {
+        const ex ri = eq.program.define(r);
+        for (const auto* group : {&eq.yd, &eq.y, &eq.u})
+          for (const auto& x : *group) {
+            direct.push_back(eq.program.diff_at(ri, x, at));
+            afterwards.push_back(eq.program.substitute(eq.program.diff(ri, x), at_too));
+          }
+      }
+      LinearEquations lin;  // sample_point reads only the operating point of `at_operating_point`
+      std::uint64_t state = detail::kSampleSeed;
+      const GiNaC::exmap point = detail::sample_point(eq, lin, state, false);
+      const Digits digits;
+      detail::PointEvaluator evaluator(eq.program, point);
+      const std::vector<numeric> a = evaluator.evaluate(direct), b = evaluator.evaluate(afterwards);
+      numeric scale = 0;
+      for (const numeric& x : b) scale = std::max(scale, GiNaC::abs(x));
+      ASSERT_GT(scale, 0) << file;
+      std::size_t exact_zeros = 0;
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        EXPECT_LE(GiNaC::abs(a[k] - b[k]), scale * numeric(1, 10).power(40)) << file << " entry " << k;
+        exact_zeros += direct[k].is_zero();
+        if (afterwards[k].is_zero()) {
+          EXPECT_TRUE(direct[k].is_zero()) << file << " entry " << k << ": not an exact zero";
+        }
+      }
+      EXPECT_GT(exact_zeros, 0u) << file;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mbsgen
