@@ -1263,7 +1263,6 @@ KernelsAhead::KernelsAhead() = default;
 KernelsAhead::KernelsAhead(KernelsAhead&&) noexcept = default;
 KernelsAhead& KernelsAhead::operator=(KernelsAhead&&) noexcept = default;
 KernelsAhead::~KernelsAhead() = default;
-bool KernelsAhead::started() const { return state_ != nullptr; }
 std::size_t KernelsAhead::taken() const { return state_ ? state_->taken : 0; }
 
 KernelsAhead emit_ahead(const Model& model, const EmitOptions& options) {

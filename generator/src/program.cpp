@@ -92,6 +92,25 @@ bool trivial(const ex& e) {  // a number, a symbol or c·symbol: never named
           isa<GiNaC::symbol>(e.op(0)));
 }
 
+// The chain rule's sum ∂e/∂x + Σ_j ∂e/∂t_j dt_j/dx over `factors` (Program::ChainFactors), each
+// partial through at() (the identity for a general derivative, a substitution for one at a
+// point), dt_j/dx from derivative(j); a partial or a derivative that is 0 drops its term, and a
+// partial that is 0 drops it before dt_j/dx is formed. Summed once: adding term by term rebuilt
+// the sum each time.
+template <class Factors, class At, class Derivative>
+ex chain_rule(const Factors& factors, std::size_t variable, At at, Derivative derivative) {
+  GiNaC::exvector terms;
+  for (const auto& [v, d] : factors.variables)
+    if (v == variable) terms.push_back(at(d));
+  for (const auto& [j, p] : factors.intermediates) {
+    const ex partial = at(p);
+    if (partial.is_zero()) continue;
+    const ex dt = derivative(j);
+    if (!dt.is_zero()) terms.push_back(partial * dt);
+  }
+  return GiNaC::add(terms);
+}
+
 }  // namespace
 
 // Functions (sin, cos, sqrt, …) and non-integer powers become intermediates of their own, so
@@ -173,16 +192,10 @@ ex Program::diff_intermediate(std::size_t k, std::size_t variable) {
   // (ChainFactors: the same expressions as differentiating f_k for each x anew, in a fraction of
   // the time); an intermediate t_j that does not depend on x contributes nothing.
   const ChainFactors& factors = chain_factors(k);  // stable: owned by a unique_ptr
-  GiNaC::exvector terms;
-  for (const auto& [v, d] : factors.variables)
-    if (v == variable) terms.push_back(d);
-  for (const auto& [j, p] : factors.intermediates) {
-    const ex dt = diff_intermediate(j, variable);
-    if (!dt.is_zero()) terms.push_back(p * dt);
-  }
+  const ex sum = chain_rule(factors, variable, [](const ex& p) { return p; },
+                            [&](std::size_t j) { return diff_intermediate(j, variable); });
   // A value holds functions and roots only at its top (define() names those inside), and the
   // derivative of one that holds none holds none either: nothing to intern.
-  const ex sum = GiNaC::add(terms);
   const ex d = internable(defs_[k].value) ? define(sum) : define_plain(sum);
   diff_memo_.emplace(key, d);
   return d;
@@ -237,15 +250,8 @@ ex Program::diff(const ex& e, const GiNaC::symbol& x) {
     if (const std::size_t* d = def_index_.find(e)) return diff_intermediate(*d, var);
     return 0;
   }
-  // ∂e/∂x + Σ ∂e/∂t_k dt_k/dx, summed once (adding term by term rebuilt the sum each time).
-  const ChainFactors factors = factors_of(e, static_cast<long>(var));
-  GiNaC::exvector terms;
-  for (const auto& [v, d] : factors.variables) terms.push_back(d);
-  for (const auto& [k, p] : factors.intermediates) {
-    const ex dt = diff_intermediate(k, var);
-    if (!dt.is_zero()) terms.push_back(p * dt);
-  }
-  return GiNaC::add(terms);
+  return chain_rule(factors_of(e, static_cast<long>(var)), var, [](const ex& p) { return p; },
+                    [&](std::size_t k) { return diff_intermediate(k, var); });
 }
 
 ex Program::substitute_intermediate(std::size_t k, Substitution& s) {
@@ -300,16 +306,8 @@ ex Program::diff_at_intermediate(std::size_t k, std::size_t variable, Substituti
   // dt_k/dx at the point = ∂f_k/∂x + Σ_j ∂f_k/∂t_j dt_j/dx, each factor at the point; a factor
   // that vanishes there drops its term before dt_j/dx is formed.
   const ChainFactors& factors = chain_factors(k);  // stable: owned by a unique_ptr
-  GiNaC::exvector terms;
-  for (const auto& [v, d] : factors.variables)
-    if (v == variable) terms.push_back(substitute(d, s));
-  for (const auto& [j, p] : factors.intermediates) {
-    const ex at = substitute(p, s);
-    if (at.is_zero()) continue;
-    const ex dt = diff_at_intermediate(j, variable, s);
-    if (!dt.is_zero()) terms.push_back(at * dt);
-  }
-  const ex d = define(GiNaC::add(terms));
+  const ex d = define(chain_rule(factors, variable, [&](const ex& p) { return substitute(p, s); },
+                                 [&](std::size_t j) { return diff_at_intermediate(j, variable, s); }));
   s.diff_memo_.emplace(key, d);
   return d;
 }
@@ -322,16 +320,8 @@ ex Program::diff_at(const ex& e, const GiNaC::symbol& x, Substitution& s) {
     if (const std::size_t* d = def_index_.find(e)) return diff_at_intermediate(*d, var, s);
     return 0;
   }
-  const ChainFactors factors = factors_of(e, static_cast<long>(var));
-  GiNaC::exvector terms;
-  for (const auto& [v, d] : factors.variables) terms.push_back(substitute(d, s));
-  for (const auto& [k, p] : factors.intermediates) {
-    const ex at = substitute(p, s);
-    if (at.is_zero()) continue;
-    const ex dt = diff_at_intermediate(k, var, s);
-    if (!dt.is_zero()) terms.push_back(at * dt);
-  }
-  return GiNaC::add(terms);
+  return chain_rule(factors_of(e, static_cast<long>(var)), var, [&](const ex& p) { return substitute(p, s); },
+                    [&](std::size_t k) { return diff_at_intermediate(k, var, s); });
 }
 
 ex Program::inline_all(const ex& e) {

@@ -96,8 +96,6 @@ class KernelsAhead {
   KernelsAhead(KernelsAhead&&) noexcept;
   KernelsAhead& operator=(KernelsAhead&&) noexcept;
   ~KernelsAhead();
-  /// Whether a child process was started.
-  bool started() const;
   /// Kernels emit() took from the child.
   std::size_t taken() const;
 
