@@ -17,8 +17,9 @@
 #   PARTS       for large models (tens of thousands of operations per kernel): the long kernels'
 #               parts go to <n> files <id>_part1.cpp … that the build compiles in parallel, at
 #               -O1 (faster to compile than -O2, and for large models as fast); default 0
-#   DYNAMICS    also emit <id>_dynamics(y, yd, u, p, M, r): M and k − q in one kernel (the full
-#               model only; not for nonholonomic models)
+#   DYNAMICS    also emit the kernels of a time step (the solver's `simulate`): <id>_dynamics(y,
+#               yd, u, p, M, r), M and k − q in one kernel, and <id>_dynamics_jacobian(y, yd,
+#               ydd, u, p, Ky, Kv) (the full model only; not for nonholonomic models)
 #
 # Documented in docs/cmake.md.
 include_guard(GLOBAL)

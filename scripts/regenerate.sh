@@ -9,7 +9,9 @@ if [[ -z "$mbsgen" ]]; then
   cmake --build build/dev --target mbsgen -j"$(nproc)"
   mbsgen=build/dev/generator/mbsgen
 fi
-while read -r id model scene; do
+while read -r id model scene flags; do
   [[ -z "$id" || "$id" == \#* ]] && continue
-  "$mbsgen" generate "$model" --scene "$scene" --id "$id" --out "generated/$id"
+  extra=()
+  [[ "${flags:-}" == dynamics ]] && extra=(--dynamics)
+  "$mbsgen" generate "$model" --scene "$scene" --id "$id" --out "generated/$id" "${extra[@]}"
 done < generated/models.txt

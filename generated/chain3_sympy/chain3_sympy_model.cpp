@@ -24,7 +24,9 @@ const mbsgen::ModelKernels& kernels() {
       chain3_sympy_coordinate_names, coordinate_units, chain3_sympy_parameter_names, parameter_units, chain3_sympy_parameter_defaults,
       chain3_sympy_input_names, input_units, chain3_sympy_output_names, output_units,
       &chain3_sympy_operating_point, &chain3_sympy_linear, &chain3_sympy_residual, &chain3_sympy_mass_matrix,
-      0, false, "0.1.0", nullptr, &chain3_sympy_outputs};
+      0, false, "0.1.0", nullptr, &chain3_sympy_outputs,
+      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
+      &chain3_sympy_dynamics, &chain3_sympy_dynamics_jacobian, nullptr};
   return k;
 }
 

@@ -24,7 +24,9 @@ const mbsgen::ModelKernels& kernels() {
       double_pendulum_coordinate_names, coordinate_units, double_pendulum_parameter_names, parameter_units, double_pendulum_parameter_defaults,
       double_pendulum_input_names, input_units, double_pendulum_output_names, output_units,
       &double_pendulum_operating_point, &double_pendulum_linear, &double_pendulum_residual, &double_pendulum_mass_matrix,
-      0, false, "0.1.0", nullptr, &double_pendulum_outputs};
+      0, false, "0.1.0", nullptr, &double_pendulum_outputs,
+      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
+      &double_pendulum_dynamics, &double_pendulum_dynamics_jacobian, nullptr};
   return k;
 }
 

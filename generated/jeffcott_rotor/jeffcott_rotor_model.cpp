@@ -24,7 +24,9 @@ const mbsgen::ModelKernels& kernels() {
       jeffcott_rotor_coordinate_names, coordinate_units, jeffcott_rotor_parameter_names, parameter_units, jeffcott_rotor_parameter_defaults,
       jeffcott_rotor_input_names, input_units, jeffcott_rotor_output_names, output_units,
       &jeffcott_rotor_operating_point, &jeffcott_rotor_linear, &jeffcott_rotor_residual, &jeffcott_rotor_mass_matrix,
-      0, false, "0.1.0", nullptr, &jeffcott_rotor_outputs};
+      0, false, "0.1.0", nullptr, &jeffcott_rotor_outputs,
+      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
+      &jeffcott_rotor_dynamics, &jeffcott_rotor_dynamics_jacobian, nullptr};
   return k;
 }
 

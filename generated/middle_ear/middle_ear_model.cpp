@@ -24,7 +24,9 @@ const mbsgen::ModelKernels& kernels() {
       middle_ear_coordinate_names, coordinate_units, middle_ear_parameter_names, parameter_units, middle_ear_parameter_defaults,
       middle_ear_input_names, input_units, middle_ear_output_names, output_units,
       &middle_ear_operating_point, &middle_ear_linear, &middle_ear_residual, &middle_ear_mass_matrix,
-      0, false, "0.1.0", nullptr, &middle_ear_outputs};
+      0, false, "0.1.0", nullptr, &middle_ear_outputs,
+      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
+      &middle_ear_dynamics, &middle_ear_dynamics_jacobian, nullptr};
   return k;
 }
 

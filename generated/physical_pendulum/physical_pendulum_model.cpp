@@ -24,7 +24,9 @@ const mbsgen::ModelKernels& kernels() {
       physical_pendulum_coordinate_names, coordinate_units, physical_pendulum_parameter_names, parameter_units, physical_pendulum_parameter_defaults,
       physical_pendulum_input_names, input_units, physical_pendulum_output_names, output_units,
       &physical_pendulum_operating_point, &physical_pendulum_linear, &physical_pendulum_residual, &physical_pendulum_mass_matrix,
-      0, false, "0.1.0", nullptr, &physical_pendulum_outputs};
+      0, false, "0.1.0", nullptr, &physical_pendulum_outputs,
+      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
+      &physical_pendulum_dynamics, &physical_pendulum_dynamics_jacobian, nullptr};
   return k;
 }
 

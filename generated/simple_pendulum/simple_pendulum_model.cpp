@@ -24,7 +24,9 @@ const mbsgen::ModelKernels& kernels() {
       simple_pendulum_coordinate_names, coordinate_units, simple_pendulum_parameter_names, parameter_units, simple_pendulum_parameter_defaults,
       simple_pendulum_input_names, input_units, simple_pendulum_output_names, output_units,
       &simple_pendulum_operating_point, &simple_pendulum_linear, &simple_pendulum_residual, &simple_pendulum_mass_matrix,
-      0, false, "0.1.0", nullptr, &simple_pendulum_outputs};
+      0, false, "0.1.0", nullptr, &simple_pendulum_outputs,
+      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
+      &simple_pendulum_dynamics, &simple_pendulum_dynamics_jacobian, nullptr};
   return k;
 }
 

@@ -24,7 +24,9 @@ const mbsgen::ModelKernels& kernels() {
       ziegler_column_coordinate_names, coordinate_units, ziegler_column_parameter_names, parameter_units, ziegler_column_parameter_defaults,
       ziegler_column_input_names, input_units, ziegler_column_output_names, output_units,
       &ziegler_column_operating_point, &ziegler_column_linear, &ziegler_column_residual, &ziegler_column_mass_matrix,
-      0, false, "0.1.0", nullptr, &ziegler_column_outputs};
+      0, false, "0.1.0", nullptr, &ziegler_column_outputs,
+      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
+      &ziegler_column_dynamics, &ziegler_column_dynamics_jacobian, nullptr};
   return k;
 }
 

@@ -302,9 +302,15 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
   for (const auto& p : model.parameters()) eq.p.push_back(p.symbol);
   if (has_reactions(original))
     for (const auto& c : original.coordinates()) eq.ydd.push_back(GiNaC::symbol(c.name + "_ddot"));
+  if (!eq.ydd.empty())
+    eq.accelerations = eq.ydd;  // the original's coordinates: reaction_outputs drops the probes' (reactions.hpp)
+  else
+    for (const auto& c : model.coordinates()) eq.accelerations.push_back(GiNaC::symbol(c.name + "_ddot"));
   Program& prog = eq.program;
   for (const auto* group : {&eq.y, &eq.yd, &eq.u, &eq.p, &eq.ydd})
     for (const auto& s : *group) prog.add_variable(s);
+  if (eq.ydd.empty())
+    for (const auto& s : eq.accelerations) prog.add_variable(s);
 
   eq.kinematics = compute_kinematics(model, prog);
   Kinematics& kin = eq.kinematics;

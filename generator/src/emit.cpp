@@ -918,11 +918,38 @@ void derivation_kernels(const Equations& eq, const std::vector<ex>& y, const std
                        {{"M", column_major(eq.M, f, f), ""}, {"r", residual, ""}}});
 }
 
-// mass_matrix, residual, linear and linear_structured: the second-order model's kernels.
+// dynamics_jacobian: the Jacobians of the equations of motion F = M(y) ÿ + k − q = 0 at any state,
+// Ky = ∂F/∂y (with the term ∂(M ÿ)/∂y) and Kv = ∂F/∂ẏ, for implicit time integration (∂F/∂ÿ = M).
+// Differentiated through the program from the form written for evaluation.
+Kernel dynamics_jacobian_kernel(Equations& eq, const std::vector<ex>& y, const std::vector<ex>& yd,
+                                const std::vector<ex>& p) {
+  const std::size_t f = eq.M.size();
+  Program& prog = eq.program;
+  const std::vector<ex>& residual = eq.residual_kernel.empty() ? eq.residual : eq.residual_kernel;
+  std::vector<ex> Ky(f * f), Kv(f * f);
+  for (std::size_t j = 0; j < f; ++j)
+    for (std::size_t i = 0; i < f; ++i) {
+      ex dy = prog.diff(residual[i], eq.y[j]);
+      for (std::size_t k = 0; k < f; ++k)
+        if (!eq.M[i][k].is_zero()) dy += prog.diff(eq.M[i][k], eq.y[j]) * eq.accelerations[k];
+      Ky[i + j * f] = dy;
+      Kv[i + j * f] = prog.diff(residual[i], eq.yd[j]);
+    }
+  const std::vector<ex> ydd(eq.accelerations.begin(), eq.accelerations.end()), u(eq.u.begin(), eq.u.end());
+  return {"dynamics_jacobian",
+          "Ky = ∂(M ydd + k − q)/∂y and Kv = ∂(k − q)/∂yd (f×f, column-major) at any state (EmitOptions::dynamics)",
+          {{"y", y}, {"yd", yd}, {"ydd", ydd}, {"u", u}, {"p", p}},
+          {{"Ky", Ky, ""}, {"Kv", Kv, ""}}};
+}
+
+// mass_matrix, residual, linear and linear_structured: the second-order model's kernels (and, asked
+// for, dynamics and dynamics_jacobian; not with closed loops, whose kernels take the tree's
+// coordinates and the independent rates).
 void second_order_kernels(Equations& eq, const LinearEquations& lin, const std::vector<ex>& y, const std::vector<ex>& yd,
                           const std::vector<ex>& p, bool dynamics, std::vector<Kernel>& kernels) {
   const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
   derivation_kernels(eq, y, yd, p, f, dynamics, kernels);
+  if (dynamics && !eq.loops.active && eq.accelerations.size() == f) kernels.push_back(dynamics_jacobian_kernel(eq, y, yd, p));
   std::vector<ex> none;
   kernels.push_back({"linear",
                      "linearized M, Q, K (f×f), B (f×m), C_y, C_v (r×f) at (y0, yd0), column-major",
@@ -1138,7 +1165,7 @@ std::string emitted_id(const Model& model, const EmitOptions& options) {
 // model only).
 std::string scene_kernel(const std::string& name) {
   if (name == "outputs_general") return "outputs";
-  if (name == "dynamics") return "mass_matrix";
+  if (name == "dynamics" || name == "dynamics_jacobian") return "mass_matrix";
   if (name == "output_terms" || name == "descriptor" || name == "reduced" || name == "reduced_parts") return "linear";
   return name;
 }

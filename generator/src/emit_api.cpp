@@ -154,6 +154,11 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     c << ",\n      " << lin.speeds.size() << ", " << id << "_speed_names, " << kernel("descriptor") << ", "
       << lin.reduced.coordinates.size() << ", " << id << "_reduced_coordinate_names, " << kernel("reduced") << ", "
       << lin.reduced.named.size() << ", " << id << "_reduced_part_names, " << kernel("reduced_parts");
+  // Time integration (EmitOptions::dynamics) and the outputs at any state.
+  if (has_kernel(code, "dynamics") || has_kernel(code, "outputs_general")) {
+    if (!lin.descriptor) c << ",\n      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr";
+    c << ",\n      " << kernel("dynamics") << ", " << kernel("dynamics_jacobian") << ", " << kernel("outputs_general");
+  }
   c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"

@@ -156,8 +156,8 @@ int main(int argc, char** argv) try {
                                    "MODEL_SCENE for a scene)");
   generate->add_flag("--no-cse", no_cse, "skip common-subexpression elimination");
   generate->add_flag("--dynamics", dynamics,
-                     "also emit dynamics(y, yd, u, p, M, r): M and k - q in one kernel sharing their work "
-                     "(for time steps; compiles both again)");
+                     "also emit the kernels of a time step (the solver's simulate): dynamics(y, yd, u, p, M, r), "
+                     "M and k - q in one kernel sharing their work, and dynamics_jacobian(y, yd, ydd, u, p, Ky, Kv)");
   generate->add_option("--parts", parts,
                        "also write ID_part1.cpp … ID_partN.cpp holding the long kernels' parts, to compile in "
                        "parallel (default 0: all in ID.cpp)")

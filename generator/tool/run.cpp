@@ -290,7 +290,7 @@ bool compile_solver(const Toolchain& tc, const fs::path& work, const GeneratedCo
 // an interrupted run leaves a half-built entry. Returns false when the compiler failed. The
 // kernels are split into 2 parts per compiler run at once (EmitOptions::parts), compiled in
 // parallel.
-bool build_solver(const std::string& model_file, const std::string& scene, const std::string& text,
+bool build_solver(const std::string& model_file, const std::string& scene, bool dynamics, const std::string& text,
                   const Toolchain& tc, const fs::path& dir, Progress& progress) {
   const Model full = read_model_file(model_file);
   const Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
@@ -300,6 +300,7 @@ bool build_solver(const std::string& model_file, const std::string& scene, const
   options.source_file = model_file;
   options.id = "model";
   options.parts = 2 * parallel;
+  options.dynamics = dynamics;
   // The kernels that need only the derivation, on the second core while this one linearizes.
   KernelsAhead ahead = progress.paused([&] { return emit_ahead(model, options); });
   progress.stage("deriving the equations");
@@ -347,7 +348,10 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
 #else
   const std::string text = read_file(model_file);  // throws: reported by the caller, exit 1
   const Toolchain tc = toolchain();
-  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
+  // `simulate` needs the kernels of a time step (EmitOptions::dynamics: the dynamics Jacobian);
+  // the other commands' solver is built without them, as they cost compile time.
+  const bool dynamics = !args.empty() && args[0] == "simulate" && scene == "full";
+  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler + (dynamics ? "\0dynamics" : "");
   for (const auto& a : tc.includes) key += '\0' + a;
   // A library or generator rebuilt in place (a developer's build tree) makes a new key: their size
   // and time of modification are part of it, so a solver is never linked against an older runtime
@@ -377,7 +381,7 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
     const auto t0 = std::chrono::steady_clock::now();
     {
       Progress progress("run");  // on a terminal, after 2 s: the stage, and files compiled
-      if (!build_solver(model_file, scene, text, tc, dir, progress)) return 1;
+      if (!build_solver(model_file, scene, dynamics, text, tc, dir, progress)) return 1;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (::isatty(STDERR_FILENO))

@@ -223,7 +223,44 @@ std::string sweep_script(const std::string& terminal, const SweepResult& r, cons
   return s.str();
 }
 
+// Series against time, one panel each (at most kMaxPanels), every label a gnuplot_string.
+std::string time_script(const std::string& terminal, const Eigen::VectorXd& t, const Eigen::MatrixXd& values,
+                        const TimePlot& plot) {
+  std::ostringstream s;
+  s << "set terminal " << terminal << "\n$series << EOD\n";
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    char field[32];
+    std::snprintf(field, sizeof field, "%.17g", t[k]);
+    s << field;
+    for (Eigen::Index i = 0; i < values.rows(); ++i) {
+      std::snprintf(field, sizeof field, " %.17g", values(i, k));
+      s << field;
+    }
+    s << "\n";
+  }
+  s << "EOD\n"
+    << "set multiplot layout " << values.rows() << ",1 title " << gnuplot_string(plot.title) << " noenhanced\n"
+    << "set grid xtics ytics\nunset key\n";
+  for (Eigen::Index i = 0; i < values.rows(); ++i) {
+    if (i + 1 == values.rows()) s << "set xlabel 'time [s]'\n";
+    s << "set ylabel " << gnuplot_string(plot.labels[static_cast<std::size_t>(i)]) << " noenhanced\n"
+      << "plot $series using 1:" << i + 2 << " with lines lw 2 lc rgb '#1f4e9c'\n";
+  }
+  s << "unset multiplot\n";
+  return s.str();
+}
+
 }  // namespace
+
+void write_time_plot(const std::string& path, const Eigen::VectorXd& t, const Eigen::MatrixXd& values,
+                     const TimePlot& plot) {
+  if (values.rows() < 1 || values.rows() > kMaxTimePanels || static_cast<std::size_t>(values.rows()) != plot.labels.size() ||
+      values.cols() != t.size())
+    throw DimensionError("write_time_plot: " + std::to_string(values.rows()) + " series (1 to " +
+                         std::to_string(kMaxTimePanels) + ", each with a label) of " + std::to_string(values.cols()) +
+                         " samples at " + std::to_string(t.size()) + " times");
+  render(path, [&](const std::string& terminal) { return time_script(terminal, t, values, plot); });
+}
 
 void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const Eigen::VectorXcd& g,
                      const BodePlot& plot) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -35,5 +36,16 @@ struct SweepPlot {
 /// Writes the eigenvalues of a parameter sweep (real parts above, imaginary parts below, the
 /// stability boundaries as dashed vertical lines) to `path`, as write_bode_plot does.
 void write_sweep_plot(const std::string& path, const SweepResult& result, const SweepPlot& plot);
+
+struct TimePlot {
+  std::string title;
+  std::vector<std::string> labels;  // one per series, e.g. "phi [rad]"
+};
+inline constexpr Eigen::Index kMaxTimePanels = 8;
+
+/// Writes series against time (one panel each, 1 to kMaxTimePanels; values: series × samples) to
+/// `path`, as write_bode_plot does. DimensionError for sizes that do not fit.
+void write_time_plot(const std::string& path, const Eigen::VectorXd& t, const Eigen::MatrixXd& values,
+                     const TimePlot& plot);
 
 }  // namespace mbsgen::cli

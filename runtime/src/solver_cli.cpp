@@ -18,6 +18,7 @@
 #include "bode_plot.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
+#include "simulate_cli.hpp"
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/matrix_market.hpp"
 #include "mbsgen/runtime/quadratic_eigen.hpp"
@@ -377,7 +378,7 @@ std::string sweep_from_scene(const ModelKernels& k, const CLI::App& frf, Options
 int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out, std::ostream& err) try {
   const std::string program = argc > 0 && argv[0] ? argv[0] : std::string(k.id) + "-solve";
   CLI::App app{std::string("solver for model '") + k.model + "', scene '" + k.scene +
-               "': modes, frequency responses, static equilibrium and matrices"};
+               "': modes, frequency responses, static equilibrium, matrices and time simulation"};
   app.name(program);
   app.require_subcommand(1);
   app.set_version_flag("--version", version_text(k), "print the versions and exit");
@@ -423,6 +424,8 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   matrices->add_option("--format", o.format, "json (standard output) or mtx (files in --out)")
       ->check(CLI::IsMember({"json", "mtx"}));
   matrices->add_option("--out", o.out_dir, "directory of the .mtx files (default: current)");
+  SimulateOptions simulate_options;
+  CLI::App* simulate = add_simulate(app, simulate_options);
   o.format = "table";
   try {
     app.parse(argc, argv);
@@ -452,6 +455,7 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     if (frf->parsed()) return run_frf(k, o, out, err);
     if (stat->parsed()) return run_static(k, o, out);
     if (sweep->parsed()) return run_sweep(k, o, out, err);
+    if (simulate->parsed()) return run_simulate(k, simulate_options, out, err);
     return run_matrices(k, o, out, err);
   } catch (const NameError& e) {
     err << program << ": " << e.what() << "\n";

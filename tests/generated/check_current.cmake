@@ -7,9 +7,17 @@ foreach(_line IN LISTS _lines)
   list(GET _fields 0 _id)
   list(GET _fields 1 _model)
   list(GET _fields 2 _scene)
+  set(_dynamics "")
+  list(LENGTH _fields _count)
+  if(_count GREATER 3)
+    list(GET _fields 3 _flag)
+    if(_flag STREQUAL "dynamics")
+      set(_dynamics --dynamics)
+    endif()
+  endif()
   file(REMOVE_RECURSE ${OUT}/${_id})
   execute_process(COMMAND ${MBSGEN} generate ${SOURCE_DIR}/${_model} --scene ${_scene} --id ${_id}
-                          --out ${OUT}/${_id}
+                          --out ${OUT}/${_id} ${_dynamics}
                   RESULT_VARIABLE _rc ERROR_VARIABLE _err)
   if(NOT _rc EQUAL 0)
     message(FATAL_ERROR "mbsgen generate ${_model} failed: ${_err}")

@@ -24,6 +24,10 @@ struct Equations {
   std::vector<GiNaC::symbol> y, yd, u, p;  ///< coordinates, rates, inputs, parameters
   /// Accelerations ÿ (`NAME_ddot`), variables only when outputs depend on them (reactions.hpp).
   std::vector<GiNaC::symbol> ydd;
+  /// The accelerations as variables of the dynamics Jacobian ∂(M ÿ + k − q)/∂y (emit's
+  /// `dynamics_jacobian`): `ydd` where outputs need them, else symbols `NAME_ddot` of their own,
+  /// registered in `program` but read by no other expression.
+  std::vector<GiNaC::symbol> accelerations;
   ExMatrix M;                               ///< f×f mass matrix M(y)
   std::vector<GiNaC::ex> residual;          ///< k(y, ẏ) − q(y, ẏ, u), length f
   /// The same k − q written for evaluation, or empty when `residual` is that form: on the link-

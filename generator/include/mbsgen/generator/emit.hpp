@@ -47,8 +47,10 @@ struct EmitOptions {
   std::size_t chunk_operations = 5000;
   static constexpr std::size_t kCutFactor = 4;
   /// Also emit `dynamics(y, yd, u, p, M, r)`: M(y) and k − q in one kernel, sharing the sines,
-  /// cosines and link transforms the two compute (what a time step needs). Off by default: it
-  /// compiles both again.
+  /// cosines and link transforms the two compute (what a time step needs), and
+  /// `dynamics_jacobian(y, yd, ydd, u, p, Ky, Kv)`: Ky = ∂(M ÿ + k − q)/∂y, Kv = ∂(k − q)/∂ẏ at any
+  /// state (the iteration matrices of implicit integration; not for closed loops). Off by
+  /// default: it compiles M and k − q again and the Jacobian is 2–3 times `linear`'s size.
   bool dynamics = false;
 };
 

@@ -80,6 +80,18 @@ struct ModelKernels {
   int n_reduced_parts = 0;
   const char* const* reduced_part_names = nullptr;
   int (*reduced_parts)(const double* y0, const double* p, double* C) = nullptr;
+  /// Time integration (issue 18; `mbsgen generate --dynamics`, EmitOptions::dynamics): M(y) and
+  /// k − q in one kernel, and the Jacobians of F = M(y) ÿ + k − q at any state, Ky = ∂F/∂y (f×f,
+  /// with ∂(M ÿ)/∂y) and Kv = ∂F/∂ẏ, column-major (null: not emitted; the full model only, and
+  /// not the Jacobian of a model with closed loops). Trailing.
+  int (*dynamics)(const double* y, const double* yd, const double* u, const double* p, double* M,
+                  double* r) = nullptr;
+  int (*dynamics_jacobian)(const double* y, const double* yd, const double* ydd, const double* u,
+                           const double* p, double* Ky, double* Kv) = nullptr;
+  /// The outputs at any state, z(y, ẏ, ÿ, u) (null: the model has no outputs on ÿ or u, and
+  /// `outputs` gives them). Trailing.
+  int (*outputs_general)(const double* y, const double* yd, const double* ydd, const double* u,
+                         const double* p, double* z) = nullptr;
 };
 
 /// The first n entries of a kernel name array (null entries become "").

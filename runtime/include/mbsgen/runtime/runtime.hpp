@@ -7,5 +7,6 @@
 #include "mbsgen/runtime/matrix_market.hpp"
 #include "mbsgen/runtime/parameter_sweep.hpp"
 #include "mbsgen/runtime/quadratic_eigen.hpp"
+#include "mbsgen/runtime/simulation.hpp"
 #include "mbsgen/runtime/static_equilibrium.hpp"
 #include "mbsgen/runtime/version.hpp"

@@ -1,0 +1,99 @@
+// Time-domain simulation of the nonlinear equations of motion M(y) ÿ + k(y, ẏ) − q(y, ẏ, u) = 0
+// of a generated model (issue 18), by SUNDIALS IDA on the implicit first-order form
+//
+//   F(t, x, x') = [ y' − v ; M(y) v' + (k − q)(y, v, u(t)) ] = 0,   x = (y, v),
+//
+// with the iteration matrix ∂F/∂x + c_j ∂F/∂x' = [c_j I, −I; K_y, c_j M + K_v] from the generated
+// kernels `dynamics` and `dynamics_jacobian` (K_y = ∂(M ÿ + k − q)/∂y, K_v = ∂(k − q)/∂ẏ), or, for
+// kernels generated without them, from `mass_matrix`, `residual` and IDA's difference quotients
+// (SimulationResult::analytic_jacobian says which). docs/simulation.md explains the choice of
+// IDA over CVODE.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "mbsgen/runtime/error.hpp"
+#include "mbsgen/runtime/generated_model.hpp"
+
+namespace mbsgen {
+
+/// A simulation that could not go on: the integrator could not meet its tolerance, the mass
+/// matrix became singular, a kernel returned non-finite values. time() is where it happened; the
+/// samples before it are not returned (no silently truncated result).
+class SimulationError : public Error {
+ public:
+  SimulationError(const std::string& what, double time) : Error(what), time_(time) {}
+  double time() const { return time_; }
+
+ private:
+  double time_;
+};
+
+/// An input as a function of time.
+class InputSignal {
+ public:
+  InputSignal() = default;  ///< zero
+  static InputSignal constant(double value);
+  /// offset + amplitude·sin(2π f t + phase).
+  static InputSignal sine(double amplitude, double frequency_hz, double phase_rad = 0, double offset = 0);
+  /// `before` until `time`, then `before + amplitude` (a breakpoint at `time`).
+  static InputSignal step(double amplitude, double time = 0, double before = 0);
+  /// amplitude·sin(φ(t)) with the frequency rising linearly from f0 at t = 0 to f1 at t = duration
+  /// (and held at f1 after it).
+  static InputSignal chirp(double amplitude, double f0_hz, double f1_hz, double duration);
+  /// Linear interpolation in a table of strictly increasing times, the end values held outside;
+  /// DimensionError / Error for mismatched sizes, fewer than one point, non-increasing times or
+  /// non-finite values.
+  static InputSignal table(std::vector<double> times, std::vector<double> values);
+  /// Parses the command line's form (docs/cli.md, `simulate --input`): VALUE, `sine:AMPLITUDE,HZ
+  /// [,PHASE_DEG[,OFFSET]]`, `step:AMPLITUDE[,TIME[,BEFORE]]`, `chirp:AMPLITUDE,F0_HZ,F1_HZ[,
+  /// DURATION]` (default: `duration`), `table:FILE` (a CSV file of t,value lines; a first line that
+  /// is not numbers is a header). NameError with the reason for anything else.
+  static InputSignal parse(const std::string& spec, double duration);
+
+  double operator()(double t) const;
+  /// Times where the signal jumps (a step): the integrator restarts there.
+  const std::vector<double>& breakpoints() const { return breakpoints_; }
+
+ private:
+  enum class Kind { constant, sine, step, chirp, table } kind_ = Kind::constant;
+  double a_ = 0, b_ = 0, c_ = 0, d_ = 0;
+  std::vector<double> t_, v_, breakpoints_;
+};
+
+struct SimulationOptions {
+  double duration = 1;  ///< s, > 0
+  double step = 1e-2;   ///< output sampling, s, > 0; the last sample is at `duration`
+  double rtol = 1e-8, atol = 1e-10;
+  /// Initial coordinates and rates by name (`phi`, `phi_dot`); the others start at the
+  /// operating point's values.
+  std::vector<std::pair<std::string, double>> initial;
+  /// One signal per input, in the kernels' order, or empty for all inputs zero.
+  std::vector<InputSignal> inputs;
+  /// Use IDA's difference quotients even when the kernels have `dynamics_jacobian` (tests).
+  bool difference_quotients = false;
+  /// Called after each output sample with its time (a progress bar).
+  std::function<void(double)> progress;
+};
+
+struct SimulationResult {
+  Eigen::VectorXd t;      ///< sample times, s
+  Eigen::MatrixXd y, yd;  ///< n_coordinates × samples
+  Eigen::MatrixXd u;      ///< n_inputs × samples
+  Eigen::MatrixXd z;      ///< n_outputs × samples (empty when the kernels give no outputs)
+  bool analytic_jacobian = false;  ///< iteration matrices from `dynamics_jacobian`
+  long steps = 0, residual_evaluations = 0, jacobian_evaluations = 0, error_test_failures = 0,
+       nonlinear_failures = 0, restarts = 0;
+};
+
+/// Integrates the model from the operating point `op` (with options.initial applied) over
+/// [0, duration]. Throws NameError for an unknown initial name, DimensionError for a wrong number
+/// of input signals, Error for invalid options or a model without second-order kernels (a
+/// nonholonomic model), SimulationError when the integration fails.
+SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op, const SimulationOptions& options);
+
+}  // namespace mbsgen

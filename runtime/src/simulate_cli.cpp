@@ -1,0 +1,200 @@
+#include "simulate_cli.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "bode_plot.hpp"
+#include "cli_files.hpp"
+#include "cli_output.hpp"
+#include "mbsgen/runtime/simulation.hpp"
+
+namespace mbsgen::cli {
+
+namespace {
+
+// "NAME=VALUE" → (NAME, VALUE text); NameError naming the option otherwise.
+std::pair<std::string, std::string> assignment(const std::string& text, const char* option) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw NameError(std::string(option) + " '" + text + "': expected NAME=VALUE");
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+SimulationOptions simulation_options(const GeneratedModel& model, const SimulateOptions& o) {
+  SimulationOptions s;
+  s.duration = o.duration;
+  s.step = o.step > 0 ? o.step : o.duration / 1000;
+  s.rtol = o.rtol;
+  s.atol = o.atol;
+  s.difference_quotients = o.difference_quotients;
+  for (const std::string& a : o.initial) {
+    const auto [name, text] = assignment(a, "--initial");
+    std::size_t used = 0;
+    double v = NAN;
+    try {
+      v = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(v))
+      throw NameError("--initial '" + a + "': '" + text + "' is not a finite number");
+    s.initial.emplace_back(name, v);
+  }
+  if (!o.inputs.empty()) s.inputs.resize(static_cast<std::size_t>(model.kernels().n_inputs));
+  for (const std::string& a : o.inputs) {
+    const auto [name, spec] = assignment(a, "--input");
+    s.inputs[static_cast<std::size_t>(model.input_index(name))] = InputSignal::parse(spec, o.duration);
+  }
+  return s;
+}
+
+// The series' names: t, the coordinates, their rates, the outputs (when the kernels give them).
+std::vector<std::string> series_names(const ModelKernels& k, const SimulationResult& r) {
+  std::vector<std::string> names = name_list(k.coordinate_names, k.n_coordinates);
+  for (int i = 0; i < k.n_coordinates; ++i) names.push_back(names[static_cast<std::size_t>(i)] + "_dot");
+  if (r.z.size() > 0)
+    for (const auto& z : name_list(k.output_names, k.n_outputs)) names.push_back(z);
+  return names;
+}
+
+Eigen::MatrixXd series_values(const SimulationResult& r) {
+  Eigen::MatrixXd v(r.y.rows() + r.yd.rows() + r.z.rows(), r.t.size());
+  v << r.y, r.yd, r.z;
+  return v;
+}
+
+void write_csv(std::ostream& out, const std::vector<std::string>& names, const Eigen::VectorXd& t,
+               const Eigen::MatrixXd& v) {
+  out << "t";
+  for (const auto& n : names) out << "," << n;
+  out << "\n";
+  for (Eigen::Index j = 0; j < t.size(); ++j) {
+    out << num(t[j], false);
+    for (Eigen::Index i = 0; i < v.rows(); ++i) out << "," << num(v(i, j), false);
+    out << "\n";
+  }
+}
+
+void write_json(std::ostream& out, const ModelKernels& k, const SimulationResult& r,
+                const std::vector<std::string>& names, const Eigen::MatrixXd& v) {
+  auto row = [&out](auto&& values, Eigen::Index size) {
+    out << "[";
+    for (Eigen::Index j = 0; j < size; ++j) out << (j ? "," : "") << num(values(j), true);
+    out << "]";
+  };
+  out << "{\"model\":" << json_string(k.model) << ",\"scene\":" << json_string(k.scene)
+      << ",\"jacobian\":" << json_string(r.analytic_jacobian ? "kernels" : "difference quotients")
+      << ",\"statistics\":{\"steps\":" << r.steps << ",\"residual_evaluations\":" << r.residual_evaluations
+      << ",\"jacobian_evaluations\":" << r.jacobian_evaluations << ",\"error_test_failures\":" << r.error_test_failures
+      << ",\"nonlinear_failures\":" << r.nonlinear_failures << ",\"restarts\":" << r.restarts << "},\"t\":";
+  row([&](Eigen::Index j) { return r.t[j]; }, r.t.size());
+  out << ",\"series\":{";
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    out << (i ? "," : "") << json_string(names[i]) << ":";
+    row([&](Eigen::Index j) { return v(static_cast<Eigen::Index>(i), j); }, v.cols());
+  }
+  out << "}}\n";
+}
+
+// The series --show names (default: the outputs, or the coordinates when there are none).
+std::vector<Eigen::Index> shown(const std::vector<std::string>& names, const SimulateOptions& o, const ModelKernels& k,
+                                const SimulationResult& r) {
+  std::vector<Eigen::Index> rows;
+  for (const std::string& s : o.show) {
+    const auto it = std::find(names.begin(), names.end(), s);
+    if (it == names.end()) {
+      std::string known;
+      for (const auto& n : names) known += " " + n;
+      throw NameError("--show '" + s + "': no such series (known:" + known + ")");
+    }
+    rows.push_back(it - names.begin());
+  }
+  if (rows.empty()) {
+    const Eigen::Index first = r.z.size() > 0 ? 2 * k.n_coordinates : 0;
+    const Eigen::Index count = r.z.size() > 0 ? k.n_outputs : k.n_coordinates;
+    for (Eigen::Index i = 0; i < std::min(count, kMaxTimePanels); ++i) rows.push_back(first + i);
+  }
+  if (static_cast<Eigen::Index>(rows.size()) > kMaxTimePanels)
+    throw NameError("--show: at most " + std::to_string(kMaxTimePanels) + " series in one plot");
+  return rows;
+}
+
+void plot(const SimulateOptions& o, const ModelKernels& k, const SimulationResult& r,
+          const std::vector<std::string>& names, const Eigen::MatrixXd& v) {
+  const std::vector<Eigen::Index> rows = shown(names, o, k, r);
+  TimePlot p;
+  p.title = std::string(k.model) + " (" + k.scene + "): simulation";
+  Eigen::MatrixXd values(static_cast<Eigen::Index>(rows.size()), v.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    values.row(static_cast<Eigen::Index>(i)) = v.row(rows[i]);
+    const Eigen::Index row = rows[i], n = k.n_coordinates;
+    const char* unit = row < 2 * n ? k.coordinate_units[row % n] : k.output_units[row - 2 * n];
+    std::string label = names[static_cast<std::size_t>(row)];
+    if (unit && *unit) label += " [" + std::string(unit) + (row >= n && row < 2 * n ? "/s" : "") + "]";
+    p.labels.push_back(label);
+  }
+  write_time_plot(o.plot, r.t, values, p);
+}
+
+}  // namespace
+
+CLI::App* add_simulate(CLI::App& app, SimulateOptions& o) {
+  CLI::App* s = app.add_subcommand("simulate", "integrate the nonlinear equations of motion in time");
+  s->add_option("--set", o.set, "set a parameter, NAME=VALUE (SI units); repeatable");
+  s->add_option("--duration", o.duration, "simulated time [s]")->required()->check(CLI::PositiveNumber);
+  s->add_option("--step", o.step, "output sampling [s] (default: duration / 1000)")->check(CLI::PositiveNumber);
+  s->add_option("--initial", o.initial, "initial coordinate or rate, NAME=VALUE or NAME_dot=VALUE; repeatable "
+                                        "(default: the operating point)");
+  s->add_option("--input", o.inputs, "an input against time, NAME=VALUE, NAME=sine:AMPLITUDE,HZ[,PHASE_DEG[,OFFSET]], "
+                                     "NAME=step:AMPLITUDE[,TIME[,BEFORE]], NAME=chirp:AMPLITUDE,F0,F1[,DURATION] or "
+                                     "NAME=table:FILE.csv (t,value lines); repeatable (default: 0)");
+  s->add_option("--rtol", o.rtol, "relative tolerance")->check(CLI::PositiveNumber);
+  s->add_option("--atol", o.atol, "absolute tolerance")->check(CLI::PositiveNumber);
+  s->add_option("--format", o.format, "output format")->check(CLI::IsMember({"csv", "json"}));
+  s->add_option("--plot", o.plot, "plot chosen series against time (FILE.svg or FILE.png)");
+  s->add_option("--show", o.show, "the series to plot (default: the outputs); repeatable");
+  s->add_flag("--difference-quotients", o.difference_quotients,
+              "iteration matrices from difference quotients even where the kernels give the Jacobian");
+  return s;
+}
+
+int run_simulate(const ModelKernels& k, const SimulateOptions& o, std::ostream& out, std::ostream& err) {
+  GeneratedModel model(k);
+  for (const auto& a : o.set) model.set(a);
+  if (model.is_descriptor())
+    throw Error("simulate: model '" + std::string(k.model) + "' has nonholonomic constraints; its kernels are the "
+                "linearization's descriptor form, and time integration of such models is not available yet");
+  if (!o.plot.empty()) refuse_special_file(o.plot, "--plot");  // before the run, not after
+  SimulationOptions s = simulation_options(model, o);
+  const bool terminal = ::isatty(STDERR_FILENO);
+  const auto start = std::chrono::steady_clock::now();
+  bool shown_progress = false;
+  s.progress = [&](double t) {
+    if (!terminal || std::chrono::steady_clock::now() - start < std::chrono::seconds(2)) return;
+    err << "\rsimulate: t = " << short_num(t) << " s (" << static_cast<int>(100 * t / s.duration) << " %)" << std::flush;
+    shown_progress = true;
+  };
+  if (!k.dynamics_jacobian && !o.difference_quotients)
+    err << "note: the kernels have no dynamics_jacobian (generate with --dynamics): iteration matrices from "
+           "difference quotients\n";
+  const SimulationResult r = simulate(model, model.operating_point(), s);
+  if (shown_progress) err << "\r" << std::string(40, ' ') << "\r";
+  const std::vector<std::string> names = series_names(k, r);
+  const Eigen::MatrixXd v = series_values(r);
+  if (!o.plot.empty()) plot(o, k, r, names, v);
+  if (o.format == "json")
+    write_json(out, k, r, names, v);
+  else
+    write_csv(out, names, r.t, v);
+  err << "simulate: " << r.t.size() << " samples, " << r.steps << " steps, " << r.residual_evaluations
+      << " residual and " << r.jacobian_evaluations << " Jacobian evaluations ("
+      << (r.analytic_jacobian ? "kernels" : "difference quotients") << "), " << r.error_test_failures
+      << " error test failures, " << r.restarts << " restarts\n";
+  if (!o.plot.empty()) err << "wrote " << o.plot << "\n";
+  return 0;
+}
+
+}  // namespace mbsgen::cli
