@@ -30,6 +30,7 @@ SimulationOptions simulation_options(const GeneratedModel& model, const Simulate
   s.rtol = o.rtol;
   s.atol = o.atol;
   s.difference_quotients = o.difference_quotients;
+  s.method = o.method == "adams" ? IntegrationMethod::adams : IntegrationMethod::bdf;
   for (const std::string& a : o.initial) {
     const auto [name, text] = assignment(a, "--initial");
     std::size_t used = 0;
@@ -78,7 +79,7 @@ void write_csv(std::ostream& out, const std::vector<std::string>& names, const E
   }
 }
 
-void write_json(std::ostream& out, const ModelKernels& k, const SimulationResult& r,
+void write_json(std::ostream& out, const ModelKernels& k, const SimulateOptions& o, const SimulationResult& r,
                 const std::vector<std::string>& names, const Eigen::MatrixXd& v) {
   auto row = [&out](auto&& values, Eigen::Index size) {
     out << "[";
@@ -86,8 +87,9 @@ void write_json(std::ostream& out, const ModelKernels& k, const SimulationResult
     out << "]";
   };
   out << "{\"model\":" << json_string(k.model) << ",\"scene\":" << json_string(k.scene)
-      << ",\"jacobian\":" << json_string(r.analytic_jacobian ? "kernels" : "difference quotients")
-      << ",\"statistics\":{\"steps\":" << r.steps << ",\"residual_evaluations\":" << r.residual_evaluations
+      << ",\"method\":" << json_string(o.method) << ",\"jacobian\":"
+      << json_string(o.method == "adams" ? "none" : r.analytic_jacobian ? "kernels" : "difference quotients")
+      << ",\"statistics\":{\"steps\":" << r.steps << ",\"rhs_evaluations\":" << r.rhs_evaluations
       << ",\"jacobian_evaluations\":" << r.jacobian_evaluations << ",\"error_test_failures\":" << r.error_test_failures
       << ",\"nonlinear_failures\":" << r.nonlinear_failures << ",\"restarts\":" << r.restarts << "},\"t\":";
   row([&](Eigen::Index j) { return r.t[j]; }, r.t.size());
@@ -153,6 +155,8 @@ CLI::App* add_simulate(CLI::App& app, SimulateOptions& o) {
                                      "NAME=table:FILE.csv (t,value lines); repeatable (default: 0)");
   s->add_option("--rtol", o.rtol, "relative tolerance")->check(CLI::PositiveNumber);
   s->add_option("--atol", o.atol, "absolute tolerance")->check(CLI::PositiveNumber);
+  s->add_option("--method", o.method, "bdf (stiff models; the default) or adams (non-stiff motion: fewer, more "
+                                     "accurate steps)")->check(CLI::IsMember({"bdf", "adams"}));
   s->add_option("--format", o.format, "output format")->check(CLI::IsMember({"csv", "json"}));
   s->add_option("--plot", o.plot, "plot chosen series against time (FILE.svg or FILE.png)");
   s->add_option("--show", o.show, "the series to plot (default: the outputs); repeatable");
@@ -177,7 +181,7 @@ int run_simulate(const ModelKernels& k, const SimulateOptions& o, std::ostream& 
     err << "\rsimulate: t = " << short_num(t) << " s (" << static_cast<int>(100 * t / s.duration) << " %)" << std::flush;
     shown_progress = true;
   };
-  if (!k.dynamics_jacobian && !o.difference_quotients)
+  if (o.method == "bdf" && !k.dynamics_jacobian && !o.difference_quotients)
     err << "note: the kernels have no dynamics_jacobian (generate with --dynamics): iteration matrices from "
            "difference quotients\n";
   const SimulationResult r = simulate(model, model.operating_point(), s);
@@ -186,12 +190,15 @@ int run_simulate(const ModelKernels& k, const SimulateOptions& o, std::ostream& 
   const Eigen::MatrixXd v = series_values(r);
   if (!o.plot.empty()) plot(o, k, r, names, v);
   if (o.format == "json")
-    write_json(out, k, r, names, v);
+    write_json(out, k, o, r, names, v);
   else
     write_csv(out, names, r.t, v);
-  err << "simulate: " << r.t.size() << " samples, " << r.steps << " steps, " << r.residual_evaluations
-      << " residual and " << r.jacobian_evaluations << " Jacobian evaluations ("
-      << (r.analytic_jacobian ? "kernels" : "difference quotients") << "), " << r.error_test_failures
+  err << "simulate: " << r.t.size() << " samples, " << o.method << ", " << r.steps << " steps, " << r.rhs_evaluations
+      << " right-hand sides";
+  if (o.method == "bdf")
+    err << ", " << r.jacobian_evaluations << " Jacobians (" << (r.analytic_jacobian ? "kernels" : "difference quotients")
+        << ")";
+  err << ", " << r.error_test_failures
       << " error test failures, " << r.restarts << " restarts\n";
   if (!o.plot.empty()) err << "wrote " << o.plot << "\n";
   return 0;

@@ -1,11 +1,12 @@
-// simulate(): SUNDIALS IDA on F(t, x, x') = [y' − v; M(y) v' + (k − q)(y, v, u(t))] (simulation.hpp).
+// simulate(): SUNDIALS CVODE on x' = (v, −M(y)⁻¹ (k − q)(y, v, u(t))), x = (y, v) (simulation.hpp).
 #include "mbsgen/runtime/simulation.hpp"
 
-#include <ida/ida.h>
+#include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include <Eigen/LU>
 
@@ -26,6 +27,13 @@ using Eigen::VectorXd;
 // Internal steps allowed between two output samples before the run is reported as stuck.
 constexpr long kMaxStepsPerSample = 200000;
 
+std::string short_number(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+
 std::string at_time(double t) {
   std::ostringstream s;
   s.precision(10);
@@ -34,127 +42,153 @@ std::string at_time(double t) {
 }
 
 // The SUNDIALS objects of one run, released in reverse order.
-struct Ida {
+struct Cvode {
   SUNContext context = nullptr;
-  N_Vector x = nullptr, xp = nullptr;
+  N_Vector x = nullptr;
   SUNMatrix A = nullptr;
   SUNLinearSolver solver = nullptr;
+  SUNNonlinearSolver fixed_point = nullptr;
   void* mem = nullptr;
-  Ida(const Ida&) = delete;
-  Ida& operator=(const Ida&) = delete;
-  explicit Ida(sunindextype size) {
+  Cvode(const Cvode&) = delete;
+  Cvode& operator=(const Cvode&) = delete;
+  Cvode(sunindextype size, IntegrationMethod method) {
     if (SUNContext_Create(nullptr, &context) != 0) throw Error("simulate: SUNContext_Create failed");
     x = N_VNew_Serial(size, context);
-    xp = N_VNew_Serial(size, context);
-    A = SUNDenseMatrix(size, size, context);
-    mem = IDACreate(context);
-    if (!x || !xp || !A || !mem) throw Error("simulate: out of memory for the integrator");
-    solver = SUNLinSol_Dense(x, A, context);
-    if (!solver) throw Error("simulate: SUNLinSol_Dense failed");
+    mem = CVodeCreate(method == IntegrationMethod::adams ? CV_ADAMS : CV_BDF, context);
+    if (!x || !mem) throw Error("simulate: out of memory for the integrator");
+    if (method == IntegrationMethod::adams) {
+      fixed_point = SUNNonlinSol_FixedPoint(x, 0, context);
+      if (!fixed_point) throw Error("simulate: SUNNonlinSol_FixedPoint failed");
+    } else {
+      A = SUNDenseMatrix(size, size, context);
+      solver = A ? SUNLinSol_Dense(x, A, context) : nullptr;
+      if (!solver) throw Error("simulate: SUNLinSol_Dense failed");
+    }
   }
-  ~Ida() {
-    if (mem) IDAFree(&mem);
+  ~Cvode() {
+    if (mem) CVodeFree(&mem);
+    if (fixed_point) SUNNonlinSolFree(fixed_point);
     if (solver) SUNLinSolFree(solver);
     if (A) SUNMatDestroy(A);
-    if (xp) N_VDestroy(xp);
     if (x) N_VDestroy(x);
     if (context) SUNContext_Free(&context);
   }
 };
 
-// The model's equations at a state, through the generated kernels.
+// The model's equations at a state, through the generated kernels: M and k − q, the
+// accelerations ÿ = −M⁻¹ (k − q), and the Jacobian kernel.
 class Equations {
  public:
   Equations(const GeneratedModel& model, const SimulationOptions& o)
       : k_(model.kernels()), p_(model.parameters()), n_(k_.n_coordinates), options_(o),
-        M_(n_, n_), r_(n_), u_(k_.n_inputs), Ky_(n_, n_), Kv_(n_, n_) {}
+        M_(n_, n_), r_(n_), u_(k_.n_inputs), a_(n_), Ky_(n_, n_), Kv_(n_, n_) {}
 
   Index size() const { return n_; }
   const ModelKernels& kernels() const { return k_; }
-  bool analytic_jacobian() const { return k_.dynamics_jacobian && !options_.difference_quotients; }
+  bool analytic_jacobian() const {
+    return options_.method == IntegrationMethod::bdf && k_.dynamics_jacobian && !options_.difference_quotients;
+  }
 
   const VectorXd& inputs(double t) {
     for (Index i = 0; i < u_.size(); ++i)
       u_[i] = options_.inputs.empty() ? 0.0 : options_.inputs[static_cast<std::size_t>(i)](t);
     return u_;
   }
-  // M and k − q at (y, ẏ, u(t)); the kernel's status (0 success, 1 non-finite, 2 loops not closed).
-  int evaluate(double t, const double* y, const double* yd) {
+  // M, k − q and ÿ at (y, ẏ, u(t)); false (with the reason kept) when a kernel fails or M is
+  // singular there.
+  bool evaluate(double t, const double* y, const double* yd) {
     inputs(t);
-    if (k_.dynamics) return k_.dynamics(y, yd, u_.data(), p_.data(), M_.data(), r_.data());
-    const int s = k_.mass_matrix(y, p_.data(), M_.data());
-    return s ? s : k_.residual(y, yd, u_.data(), p_.data(), r_.data());
+    int s = 0;
+    if (k_.dynamics) {
+      s = k_.dynamics(y, yd, u_.data(), p_.data(), M_.data(), r_.data());
+    } else {
+      s = k_.mass_matrix(y, p_.data(), M_.data());
+      if (s == 0) s = k_.residual(y, yd, u_.data(), p_.data(), r_.data());
+    }
+    if (s != 0) return fail(t, s == 2 ? Failure::loops : Failure::non_finite);
+    lu_.compute(M_);
+    // Eigen's rcond() estimate is 1 for an exactly singular M (a zero pivot makes its solves
+    // inf or NaN): the pivots' ratio bounds the reciprocal condition number from above.
+    double rcond = 1.0;
+    if (n_ > 0) {
+      const VectorXd pivots = lu_.matrixLU().diagonal().cwiseAbs();
+      rcond = std::min(lu_.rcond(), pivots.minCoeff() / pivots.maxCoeff());
+    }
+    if (!(rcond > static_cast<double>(n_) * std::numeric_limits<double>::epsilon())) {
+      rcond_ = rcond;
+      return fail(t, Failure::singular_mass);
+    }
+    a_ = lu_.solve(-r_);
+    return true;
   }
-  int jacobian(const double* y, const double* yd, const double* ydd) {
-    return k_.dynamics_jacobian(y, yd, ydd, u_.data(), p_.data(), Ky_.data(), Kv_.data());
+  // ∂ÿ/∂y = −M⁻¹ K_y(y, ẏ, ÿ) and ∂ÿ/∂ẏ = −M⁻¹ K_v after evaluate() at the same state.
+  bool jacobian(double t, const double* y, const double* yd, Eigen::Ref<MatrixXd> dy, Eigen::Ref<MatrixXd> dv) {
+    if (k_.dynamics_jacobian(y, yd, a_.data(), u_.data(), p_.data(), Ky_.data(), Kv_.data()) != 0)
+      return fail(t, Failure::non_finite);
+    dy = -lu_.solve(Ky_);
+    dv = -lu_.solve(Kv_);
+    return true;
   }
-  // ÿ = −M⁻¹ (k − q) at the last evaluate(), or a SimulationError when M is singular there.
-  VectorXd accelerations(double t) const {
-    const Eigen::PartialPivLU<MatrixXd> lu(M_);
-    const double rcond = n_ ? lu.rcond() : 1.0;
-    if (!(rcond > static_cast<double>(n_) * std::numeric_limits<double>::epsilon()))
-      throw SimulationError("simulate: the mass matrix is singular " + at_time(t) + " (reciprocal condition number " +
-                                std::to_string(rcond) + "): no unique accelerations there",
-                            t);
-    return lu.solve(-r_);
-  }
-  const MatrixXd& M() const { return M_; }
-  const VectorXd& r() const { return r_; }
-  const MatrixXd& Ky() const { return Ky_; }
-  const MatrixXd& Kv() const { return Kv_; }
+  const VectorXd& accelerations() const { return a_; }
   const std::vector<double>& parameters() const { return p_; }
 
-  int failed_status = 0;  // the last kernel status that was not 0, for the error message
+  enum class Failure { none, non_finite, loops, singular_mass };
+  Failure failure = Failure::none;  // the first failure of the current attempt, for the message
   double failed_time = 0;
+  std::string reason() const {
+    switch (failure) {
+      case Failure::non_finite:
+        return "the kernels returned non-finite values (the state or a parameter left the model's range)";
+      case Failure::loops:
+        return "the kinematic loops could not be closed (a dead point, or far from the operating point)";
+      case Failure::singular_mass:
+        return "the mass matrix is singular (reciprocal condition number " + short_number(rcond_) +
+               "): no unique accelerations";
+      case Failure::none:
+        break;
+    }
+    return "";
+  }
 
  private:
+  bool fail(double t, Failure f) {
+    failure = f;
+    failed_time = t;
+    return false;
+  }
   const ModelKernels& k_;
   std::vector<double> p_;
   Index n_;
   const SimulationOptions& options_;
   MatrixXd M_;
-  VectorXd r_, u_;
+  VectorXd r_, u_, a_;
   MatrixXd Ky_, Kv_;
+  Eigen::PartialPivLU<MatrixXd> lu_;
+  double rcond_ = 0;
 };
 
-int residual_function(realtype t, N_Vector x, N_Vector xp, N_Vector F, void* data) {
+// x' = (v, ÿ(y, v, u(t))).
+int rhs_function(realtype t, N_Vector x, N_Vector xp, void* data) {
   auto& eq = *static_cast<Equations*>(data);
   const Index n = eq.size();
   const double* xs = N_VGetArrayPointer(x);
-  const double* xps = N_VGetArrayPointer(xp);
-  double* f = N_VGetArrayPointer(F);
-  const int status = eq.evaluate(t, xs, xs + n);
-  if (status != 0) {
-    eq.failed_status = status;
-    eq.failed_time = t;
-    return 1;  // recoverable: IDA retries with a smaller step
-  }
-  Eigen::Map<VectorXd>(f, n) = Eigen::Map<const VectorXd>(xps, n) - Eigen::Map<const VectorXd>(xs + n, n);
-  Eigen::Map<VectorXd>(f + n, n) = eq.M() * Eigen::Map<const VectorXd>(xps + n, n) + eq.r();
+  double* f = N_VGetArrayPointer(xp);
+  if (!eq.evaluate(t, xs, xs + n)) return 1;  // recoverable: CVODE retries with a smaller step
+  Eigen::Map<VectorXd>(f, n) = Eigen::Map<const VectorXd>(xs + n, n);
+  Eigen::Map<VectorXd>(f + n, n) = eq.accelerations();
   return 0;
 }
 
-// ∂F/∂x + c_j ∂F/∂x' = [c_j I, −I; K_y, c_j M + K_v].
-int jacobian_function(realtype t, realtype cj, N_Vector x, N_Vector xp, N_Vector, SUNMatrix J, void* data, N_Vector,
-                      N_Vector, N_Vector) {
+// ∂x'/∂x = [0, I; −M⁻¹ K_y, −M⁻¹ K_v], with K_y at ÿ = x'[n:] (the right-hand side CVODE passes).
+int jacobian_function(realtype t, N_Vector x, N_Vector, SUNMatrix J, void* data, N_Vector, N_Vector, N_Vector) {
   auto& eq = *static_cast<Equations*>(data);
   const Index n = eq.size();
   const double* xs = N_VGetArrayPointer(x);
-  const double* xps = N_VGetArrayPointer(xp);
-  int status = eq.evaluate(t, xs, xs + n);
-  if (status == 0) status = eq.jacobian(xs, xs + n, xps + n);
-  if (status != 0) {
-    eq.failed_status = status;
-    eq.failed_time = t;
-    return 1;
-  }
+  if (!eq.evaluate(t, xs, xs + n)) return 1;
   Eigen::Map<MatrixXd> A(SM_DATA_D(J), 2 * n, 2 * n);
   A.setZero();
-  A.topLeftCorner(n, n).diagonal().setConstant(cj);
-  A.topRightCorner(n, n).diagonal().setConstant(-1.0);
-  A.bottomLeftCorner(n, n) = eq.Ky();
-  A.bottomRightCorner(n, n) = cj * eq.M() + eq.Kv();
-  return 0;
+  A.topRightCorner(n, n).diagonal().setOnes();
+  return eq.jacobian(t, xs, xs + n, A.bottomLeftCorner(n, n), A.bottomRightCorner(n, n)) ? 0 : 1;
 }
 
 void error_handler(int, const char*, const char*, char* message, void* data) {
@@ -205,75 +239,67 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
                          std::to_string(k.n_inputs) + " inputs");
 }
 
-// The reason an IDASolve flag gives, and the time: for a failed Newton iteration or matrix
-// factorization, a singular mass matrix there is named as the cause.
-[[noreturn]] void integration_failed(int flag, Ida& ida, Equations& eq, const std::string& message) {
+// The reason a CVode flag gives, and the time.
+[[noreturn]] void integration_failed(int flag, Cvode& cv, const Equations& eq, const std::string& message) {
   double t = 0;
-  IDAGetCurrentTime(ida.mem, &t);
-  const Index n = eq.size();
-  const double* x = N_VGetArrayPointer(ida.x);
+  CVodeGetCurrentTime(cv.mem, &t);
   std::string why;
   switch (flag) {
-    case IDA_TOO_MUCH_WORK:
+    case CV_TOO_MUCH_WORK:
       why = "more than " + std::to_string(kMaxStepsPerSample) +
-            " internal steps between two samples (the tolerance cannot be met at a reasonable cost, or the "
-            "motion is too fast for the output step)";
+            " internal steps between two samples (the tolerance cannot be met at a reasonable cost, the problem is "
+            "stiff for --method adams, or the motion is too fast for the output step)";
       break;
-    case IDA_TOO_MUCH_ACC:
+    case CV_TOO_MUCH_ACC:
       why = "the tolerances ask for more accuracy than double precision gives (loosen --rtol/--atol)";
       break;
-    case IDA_ERR_FAIL:
+    case CV_ERR_FAILURE:
       why = "the error test failed repeatedly: the integrator cannot meet the tolerance";
       break;
-    case IDA_RES_FAIL:
-    case IDA_REP_RES_ERR:
-    case IDA_FIRST_RES_FAIL:
-      t = eq.failed_time;
-      why = eq.failed_status == 2 ? "the kinematic loops could not be closed (a dead point, or far from the operating point)"
-                                  : "the kernels returned non-finite values (the state or a parameter left the model's range)";
+    case CV_CONV_FAILURE:
+      why = "the corrector iteration failed to converge repeatedly";
       break;
-    default:
-      if (eq.evaluate(t, x, x + n) == 0) eq.accelerations(t);  // throws when M is singular there
-      why = flag == IDA_CONV_FAIL ? "Newton's iteration failed to converge repeatedly"
-                                  : "the iteration matrix could not be factorized or solved";
+    default: {
+      double h = 0;
+      CVodeGetLastStep(cv.mem, &h);
+      why = std::abs(h) <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t))
+                ? "the step size fell to " + short_number(h) + " s, below the resolution of t: the motion is too fast "
+                  "there (forces or parameters far out of range?)"
+                : "the integrator failed (CVODE flag " + std::to_string(flag) + ")";
+    }
+  }
+  if (eq.failure != Equations::Failure::none) {  // the cause the kernels or M gave
+    t = eq.failed_time;
+    why = eq.reason();
   }
   throw SimulationError("simulate: the integration stopped " + at_time(t) + ": " + why +
-                            (message.empty() ? "" : " [IDA: " + message + "]"),
+                            (message.empty() ? "" : " [CVODE: " + message + "]"),
                         t);
 }
 
-// Consistent derivatives at t: y' = v and v' = −M⁻¹ (k − q) with the inputs just after t.
-void consistent_rates(Ida& ida, Equations& eq, double t) {
-  const Index n = eq.size();
-  const double* x = N_VGetArrayPointer(ida.x);
-  double* xp = N_VGetArrayPointer(ida.xp);
-  const double after = std::nextafter(t, std::numeric_limits<double>::infinity());
-  if (eq.evaluate(after, x, x + n) != 0)
-    throw SimulationError("simulate: the kernels returned non-finite values " + at_time(t) +
-                              " (the initial state or a parameter is outside the model's range)",
-                          t);
-  Eigen::Map<VectorXd>(xp, n) = Eigen::Map<const VectorXd>(x + n, n);
-  Eigen::Map<VectorXd>(xp + n, n) = eq.accelerations(t);
-}
-
-void configure(Ida& ida, Equations& eq, const SimulationOptions& o, std::string& message) {
+void configure(Cvode& cv, Equations& eq, const SimulationOptions& o, std::string& message) {
   auto check = [](int flag, const char* what) {
     if (flag != 0) throw Error(std::string("simulate: ") + what + " failed (" + std::to_string(flag) + ")");
   };
-  check(IDAInit(ida.mem, residual_function, 0.0, ida.x, ida.xp), "IDAInit");
-  check(IDASStolerances(ida.mem, o.rtol, o.atol), "IDASStolerances");
-  check(IDASetUserData(ida.mem, &eq), "IDASetUserData");
-  check(IDASetErrHandlerFn(ida.mem, error_handler, &message), "IDASetErrHandlerFn");
-  check(IDASetLinearSolver(ida.mem, ida.solver, ida.A), "IDASetLinearSolver");
-  if (eq.analytic_jacobian()) check(IDASetJacFn(ida.mem, jacobian_function), "IDASetJacFn");
-  check(IDASetMaxNumSteps(ida.mem, kMaxStepsPerSample), "IDASetMaxNumSteps");
+  check(CVodeInit(cv.mem, rhs_function, 0.0, cv.x), "CVodeInit");
+  check(CVodeSStolerances(cv.mem, o.rtol, o.atol), "CVodeSStolerances");
+  check(CVodeSetUserData(cv.mem, &eq), "CVodeSetUserData");
+  check(CVodeSetErrHandlerFn(cv.mem, error_handler, &message), "CVodeSetErrHandlerFn");
+  if (cv.fixed_point) {
+    check(CVodeSetNonlinearSolver(cv.mem, cv.fixed_point), "CVodeSetNonlinearSolver");
+  } else {
+    check(CVodeSetLinearSolver(cv.mem, cv.solver, cv.A), "CVodeSetLinearSolver");
+    if (eq.analytic_jacobian()) check(CVodeSetJacFn(cv.mem, jacobian_function), "CVodeSetJacFn");
+  }
+  check(CVodeSetMaxNumSteps(cv.mem, kMaxStepsPerSample), "CVodeSetMaxNumSteps");
+  check(CVodeSetMaxHnilWarns(cv.mem, -1), "CVodeSetMaxHnilWarns");  // no messages on stderr
 }
 
 // Stores sample j: the state, the inputs and the outputs at t.
-void record(SimulationResult& r, Index j, double t, Ida& ida, Equations& eq) {
+void record(SimulationResult& r, Index j, double t, Cvode& cv, Equations& eq) {
   const ModelKernels& k = eq.kernels();
   const Index n = eq.size();
-  const double* x = N_VGetArrayPointer(ida.x);
+  const double* x = N_VGetArrayPointer(cv.x);
   r.t[j] = t;
   r.y.col(j) = Eigen::Map<const VectorXd>(x, n);
   r.yd.col(j) = Eigen::Map<const VectorXd>(x + n, n);
@@ -284,9 +310,9 @@ void record(SimulationResult& r, Index j, double t, Ida& ida, Equations& eq) {
   const std::vector<double>& p = eq.parameters();
   int status = 0;
   if (k.outputs_general) {
-    if (eq.evaluate(t, x, x + n) != 0) throw SimulationError("simulate: non-finite kernel values " + at_time(t), t);
-    const VectorXd ydd = eq.accelerations(t), u = r.u.col(j);
-    status = k.outputs_general(x, x + n, ydd.data(), u.data(), p.data(), r.z.col(j).data());
+    if (!eq.evaluate(t, x, x + n)) throw SimulationError("simulate: " + eq.reason() + " " + at_time(t), t);
+    const VectorXd u = r.u.col(j);
+    status = k.outputs_general(x, x + n, eq.accelerations().data(), u.data(), p.data(), r.z.col(j).data());
   } else {
     status = k.outputs(x, x + n, p.data(), r.z.col(j).data());
   }
@@ -302,13 +328,23 @@ std::vector<double> breakpoints(const SimulationOptions& o) {
   return {b.begin(), b.end()};
 }
 
-void statistics(Ida& ida, SimulationResult& r) {
+void add_statistics(Cvode& cv, SimulationResult& r) {
   long v = 0;
-  IDAGetNumSteps(ida.mem, &v), r.steps += v;
-  IDAGetNumResEvals(ida.mem, &v), r.residual_evaluations += v;
-  IDAGetNumJacEvals(ida.mem, &v), r.jacobian_evaluations += v;
-  IDAGetNumErrTestFails(ida.mem, &v), r.error_test_failures += v;
-  IDAGetNumNonlinSolvConvFails(ida.mem, &v), r.nonlinear_failures += v;
+  CVodeGetNumSteps(cv.mem, &v), r.steps += v;
+  CVodeGetNumRhsEvals(cv.mem, &v), r.rhs_evaluations += v;
+  if (cv.solver) CVodeGetNumJacEvals(cv.mem, &v), r.jacobian_evaluations += v;
+  CVodeGetNumErrTestFails(cv.mem, &v), r.error_test_failures += v;
+  CVodeGetNumNonlinSolvConvFails(cv.mem, &v), r.nonlinear_failures += v;
+}
+
+SimulationResult allocated(const ModelKernels& k, Index samples) {
+  SimulationResult r;
+  r.t.resize(samples);
+  r.y.resize(k.n_coordinates, samples);
+  r.yd.resize(k.n_coordinates, samples);
+  r.u.resize(k.n_inputs, samples);
+  if (k.outputs || k.outputs_general) r.z.resize(k.n_outputs, samples);
+  return r;
 }
 
 }  // namespace
@@ -320,46 +356,45 @@ SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op,
   VectorXd y, yd;
   initial_state(model, op, o, y, yd);
   Equations eq(model, o);
-  Ida ida(2 * n);
+  Cvode cv(2 * n, o.method);
   std::string message;
-  Eigen::Map<VectorXd>(N_VGetArrayPointer(ida.x), n) = y;
-  Eigen::Map<VectorXd>(N_VGetArrayPointer(ida.x) + n, n) = yd;
-  consistent_rates(ida, eq, 0.0);
-  configure(ida, eq, o, message);
+  Eigen::Map<VectorXd>(N_VGetArrayPointer(cv.x), n) = y;
+  Eigen::Map<VectorXd>(N_VGetArrayPointer(cv.x) + n, n) = yd;
+  if (!eq.evaluate(0.0, y.data(), yd.data()))
+    throw SimulationError("simulate: the initial state fails " + at_time(0) + ": " + eq.reason(), 0.0);
+  configure(cv, eq, o, message);
 
   const auto samples = static_cast<Index>(std::ceil(o.duration / o.step * (1 - 1e-12))) + 1;
-  SimulationResult r;
+  SimulationResult r = allocated(k, samples);
   r.analytic_jacobian = eq.analytic_jacobian();
-  r.t.resize(samples);
-  r.y.resize(n, samples);
-  r.yd.resize(n, samples);
-  r.u.resize(k.n_inputs, samples);
-  if (k.outputs || k.outputs_general) r.z.resize(k.n_outputs, samples);
-  record(r, 0, 0.0, ida, eq);
+  record(r, 0, 0.0, cv, eq);
   const std::vector<double> breaks = breakpoints(o);
   auto next_break = breaks.begin();
   double t = 0;
   for (Index j = 1; j < samples; ++j) {
-    const double tout = j + 1 == samples ? o.duration : std::min(o.duration, static_cast<double>(j) * o.step);
+    double tout = j + 1 == samples ? o.duration : std::min(o.duration, static_cast<double>(j) * o.step);
+    // A sample within rounding of a breakpoint is taken at the breakpoint (the integrator
+    // restarts there and cannot start a step of a few ulps).
+    if (next_break != breaks.end() && std::abs(*next_break - tout) <= 1e-9 * o.step) tout = *next_break;
     while (t < tout) {
       const bool at_break = next_break != breaks.end() && *next_break <= tout;
       const double stop = at_break ? *next_break : o.duration;
-      IDASetStopTime(ida.mem, stop);
+      CVodeSetStopTime(cv.mem, stop);
       double reached = t;
-      const int flag = IDASolve(ida.mem, std::min(tout, stop), &reached, ida.x, ida.xp, IDA_NORMAL);
-      if (flag < 0) integration_failed(flag, ida, eq, message);
+      eq.failure = Equations::Failure::none;
+      const int flag = CVode(cv.mem, std::min(tout, stop), cv.x, &reached, CV_NORMAL);
+      if (flag < 0) integration_failed(flag, cv, eq, message);
       t = reached;
-      if (at_break && t >= stop) {  // restart after the jump with consistent derivatives
-        statistics(ida, r);
-        consistent_rates(ida, eq, stop);
-        IDAReInit(ida.mem, stop, ida.x, ida.xp);
+      if (at_break && t >= stop) {  // restart after the jump: the history holds the old input
+        add_statistics(cv, r);
+        CVodeReInit(cv.mem, stop, cv.x);
         ++r.restarts, ++next_break;
       }
     }
-    record(r, j, tout, ida, eq);
+    record(r, j, tout, cv, eq);
     if (o.progress) o.progress(tout);
   }
-  statistics(ida, r);
+  add_statistics(cv, r);
   return r;
 }
 

@@ -7,11 +7,13 @@
 #include "jeffcott_rotor_model.hpp"
 #include "middle_ear_model.hpp"
 #include "simple_pendulum_model.hpp"
+#include "spherical_pendulum_conical_model.hpp"
 
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/simulation.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -54,20 +56,20 @@ std::vector<double> zero_crossings(const SimulationResult& r, Eigen::Index i) {
 
 // The period of the simple pendulum at amplitude θ0: T = 4 √(l/g) K(sin(θ0/2)) (the complete
 // elliptic integral of the first kind of modulus k; e.g. Landau & Lifshitz, Mechanics, §11,
-// problem 1), against the zero crossings of φ over ten periods at rtol 1e-12: to 1e-9.
+// problem 1), against the zero crossings of φ over ten periods (Adams, rtol 1e-12): to 1e-9.
 TEST(Simulation, SimplePendulumPeriodAtLargeAmplitudeMatchesTheEllipticIntegral) {
   GeneratedModel model(simple_pendulum::kernels());
   const double l = 1.0, g = 9.81;
   for (double theta0 : {0.1, 1.0, 2.5, 3.0}) {
     const double T = 4 * std::sqrt(l / g) * std::comp_ellint_1(std::sin(theta0 / 2));
     SimulationOptions o;
+    o.method = mbsgen::IntegrationMethod::adams;
     o.duration = 10.2 * T;
     o.step = 1e-3;
     o.rtol = 1e-12;
     o.atol = 1e-14;
     o.initial = {{"phi", theta0}};
     const SimulationResult r = run(model, o);
-    EXPECT_TRUE(r.analytic_jacobian);
     const std::vector<double> c = zero_crossings(r, 0);  // at T/4 + j T/2
     ASSERT_EQ(c.size(), 20u) << "theta0 " << theta0;
     const double measured = 2 * (c.back() - c.front()) / static_cast<double>(c.size() - 1);
@@ -86,26 +88,266 @@ double double_pendulum_energy(double p1, double p2, double w1, double w2) {
   return kinetic + potential;
 }
 
-// Conservative: the energy stays within 1e-8 of its initial value (relative to the energy
-// scale m g l) over 100 periods of the slower mode at rtol 1e-10, at moderate and at large
-// amplitude (chaotic motion).
+double energy_drift(const GeneratedModel& model, mbsgen::IntegrationMethod method, double p1, double p2, double rtol,
+                    long* steps = nullptr) {
+  const double slow = 2 * kPi / std::sqrt((2 - std::sqrt(2.0)) * 9.81);  // closed-forms.md §2
+  SimulationOptions o;
+  o.method = method;
+  o.duration = 100 * slow;
+  o.step = slow / 20;
+  o.rtol = rtol;
+  o.atol = rtol / 100;
+  o.initial = {{"phi1", p1}, {"phi2", p2}};
+  const SimulationResult r = run(model, o);
+  const double e0 = double_pendulum_energy(p1, p2, 0, 0), scale = 9.81;  // m g l
+  double worst = 0;
+  for (Eigen::Index k = 0; k < r.t.size(); ++k)
+    worst = std::max(worst, std::abs(double_pendulum_energy(r.y(0, k), r.y(1, k), r.yd(0, k), r.yd(1, k)) - e0));
+  if (steps) *steps = r.steps;
+  return worst / scale;
+}
+
+// Conservative: over 100 periods of the slower mode at rtol 1e-10, Adams keeps the energy within
+// 1e-8 of its initial value (relative to the energy scale m g l).
 TEST(Simulation, DoublePendulumConservesEnergyOver100Periods) {
   GeneratedModel model(double_pendulum::kernels());
-  const double slow = 2 * kPi / std::sqrt((2 - std::sqrt(2.0)) * 9.81);  // closed-forms.md §2
-  for (const auto& [p1, p2] : std::vector<std::pair<double, double>>{{0.3, -0.2}, {1.5, 2.0}}) {
-    SimulationOptions o;
-    o.duration = 100 * slow;
-    o.step = slow / 20;
-    o.rtol = 1e-10;
-    o.atol = 1e-12;
-    o.initial = {{"phi1", p1}, {"phi2", p2}};
-    const SimulationResult r = run(model, o);
-    const double e0 = double_pendulum_energy(p1, p2, 0, 0), scale = 9.81;
-    double worst = 0;
-    for (Eigen::Index k = 0; k < r.t.size(); ++k)
-      worst = std::max(worst, std::abs(double_pendulum_energy(r.y(0, k), r.y(1, k), r.yd(0, k), r.yd(1, k)) - e0));
-    EXPECT_LT(worst / scale, 1e-8) << "from phi1 " << p1 << ", phi2 " << p2 << " (" << r.steps << " steps)";
+  long steps = 0;
+  const double drift = energy_drift(model, mbsgen::IntegrationMethod::adams, 0.3, -0.2, 1e-10, &steps);
+  EXPECT_LT(drift, 1e-8) << steps << " steps";
+}
+
+// The drift is the integrator's error, so it falls with the tolerance: by at least 10 from rtol
+// 1e-9 to 1e-11 for both methods, also in chaotic motion (from 1.5 and 2 rad); BDF on the
+// Jacobian kernel and on difference quotients alike.
+TEST(Simulation, DoublePendulumEnergyDriftFallsWithTheTolerance) {
+  GeneratedModel model(double_pendulum::kernels());
+  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::bdf})
+    for (const auto& [p1, p2] : std::vector<std::pair<double, double>>{{0.3, -0.2}, {1.5, 2.0}}) {
+      const double coarse = energy_drift(model, method, p1, p2, 1e-9), fine = energy_drift(model, method, p1, p2, 1e-11);
+      EXPECT_LT(fine, coarse / 10) << (method == mbsgen::IntegrationMethod::bdf ? "bdf" : "adams") << " from " << p1
+                                   << ", " << p2 << ": " << coarse << " at 1e-9, " << fine << " at 1e-11";
+    }
+}
+
+
+// The Jacobian kernel against central differences of F = M(y) ÿ + k − q through the mass-matrix
+// and residual kernels, at a state where every variable differs, of the model's size (radians
+// for the pendulums, millimetres for the rotor, 10 µm and 10 mrad for the middle ear). The step h
+// balances the truncation error O(h²) against the rounding error O(ε |F| / h): the middle ear's
+// F holds forces much larger than their changes, and its quotients agree with the kernel to
+// 1e-11 at h = 1e-6 but only to 1e-5 at h = 1e-10. So 1e-7 of the column's largest entry (plus
+// 1e-12 of the matrix's, for entries whose quotient is an exact 0 and the kernel's a rounding
+// error).
+TEST(Simulation, DynamicsJacobianKernelEqualsCentralDifferences) {
+  struct Case {
+    const mbsgen::ModelKernels* k;
+    double size, h;
+  };
+  for (const Case c : {Case{&double_pendulum::kernels(), 0.5, 1e-5}, Case{&chain3_sympy::kernels(), 0.5, 1e-5},
+                       Case{&jeffcott_rotor::kernels(), 1e-3, 1e-6}, Case{&middle_ear::kernels(), 1e-5, 1e-6}}) {
+    const mbsgen::ModelKernels* k = c.k;
+    ASSERT_NE(k->dynamics_jacobian, nullptr) << k->model;
+    GeneratedModel model(*k);
+    const std::vector<double>& p = model.parameters();
+    const Eigen::Index n = k->n_coordinates;
+    const mbsgen::OperatingPoint op = model.operating_point();
+    Eigen::VectorXd y = op.y0, yd(n), ydd(n), u(k->n_inputs);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      y[i] += c.size * std::sin(1.0 + i);
+      yd[i] = 3 * c.size * std::cos(2.0 + i);
+      ydd[i] = 50 * c.size * std::sin(3.0 * i);
+    }
+    u.setConstant(0.7);
+    auto F = [&](const Eigen::VectorXd& yy, const Eigen::VectorXd& vv) {
+      Eigen::MatrixXd M(n, n);
+      Eigen::VectorXd r(n);
+      EXPECT_EQ(k->mass_matrix(yy.data(), p.data(), M.data()), 0);
+      EXPECT_EQ(k->residual(yy.data(), vv.data(), u.data(), p.data(), r.data()), 0);
+      return Eigen::VectorXd(M * ydd + r);
+    };
+    Eigen::MatrixXd Ky(n, n), Kv(n, n), dy(n, n), dv(n, n);
+    ASSERT_EQ(k->dynamics_jacobian(y.data(), yd.data(), ydd.data(), u.data(), p.data(), Ky.data(), Kv.data()), 0);
+    const double h = c.h;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      Eigen::VectorXd a = y, b = y, e = yd, f = yd;
+      a[j] += h, b[j] -= h, e[j] += 3 * h, f[j] -= 3 * h;
+      dy.col(j) = (F(a, yd) - F(b, yd)) / (2 * h);
+      dv.col(j) = (F(y, e) - F(y, f)) / (6 * h);
+    }
+    const double Ky_size = dy.cwiseAbs().maxCoeff(), Kv_size = dv.cwiseAbs().maxCoeff();
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = 0; i < n; ++i) {
+        EXPECT_NEAR(Ky(i, j), dy(i, j), 1e-7 * dy.col(j).cwiseAbs().maxCoeff() + 1e-12 * Ky_size)
+            << k->model << " Ky " << i << "," << j;
+        EXPECT_NEAR(Kv(i, j), dv(i, j), 1e-7 * dv.col(j).cwiseAbs().maxCoeff() + 1e-12 * Kv_size)
+            << k->model << " Kv " << i << "," << j;
+      }
   }
+}
+
+// The Jeffcott rotor's equations are linear (a point mass on linear springs and dampers, with the
+// rotating damping's circulatory term), so the step response has the closed form
+// x(t) = U (e^{A(t−ts)} − I) A⁻¹ b after the step at ts, through the eigenvectors of the first-
+// order matrix A (Eigen's EigenSolver, not the runtime's). The step restarts the integrator at
+// ts. The global error over 160 periods of the whirl is not bounded by the local tolerance, but
+// it falls with it: BDF (kernel and difference-quotient Jacobians) and Adams must agree to 1e-7
+// of the response's size at rtol 1e-11, and tenfold better than at rtol 1e-9.
+TEST(Simulation, LinearRotorStepResponseMatchesTheMatrixExponential) {
+  GeneratedModel model(jeffcott_rotor::kernels());
+  const mbsgen::LinearModel lin = model.linear_model();
+  const Eigen::Index n = 2;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomLeftCorner(n, n) = -lin.M().lu().solve(lin.K());
+  A.bottomRightCorner(n, n) = -lin.M().lu().solve(lin.Q());
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(2 * n);
+  b.tail(n) = lin.M().lu().solve(lin.B().col(0));
+  const Eigen::EigenSolver<Eigen::MatrixXd> es(A);
+  const Eigen::MatrixXcd V = es.eigenvectors();
+  const Eigen::VectorXcd lambda = es.eigenvalues();
+  const Eigen::VectorXcd w = V.lu().solve(A.cast<std::complex<double>>().lu().solve(b.cast<std::complex<double>>()));
+  const double U = 2.0, ts = 0.013;
+  auto exact = [&](double t) {
+    if (t <= ts) return Eigen::VectorXd(Eigen::VectorXd::Zero(2 * n));
+    Eigen::VectorXcd e(2 * n);
+    for (Eigen::Index i = 0; i < 2 * n; ++i) e[i] = (std::exp(lambda[i] * (t - ts)) - 1.0) * w[i];
+    return Eigen::VectorXd(U * (V * e).real());
+  };
+  struct Case {
+    mbsgen::IntegrationMethod method;
+    bool quotients;
+  };
+  for (const Case c : {Case{mbsgen::IntegrationMethod::bdf, false}, Case{mbsgen::IntegrationMethod::bdf, true},
+                       Case{mbsgen::IntegrationMethod::adams, false}}) {
+    double error[2] = {};
+    for (int tight = 0; tight < 2; ++tight) {
+      SimulationOptions o;
+      o.method = c.method;
+      o.difference_quotients = c.quotients;
+      o.duration = 5;
+      o.step = 1e-3;
+      o.rtol = tight ? 1e-11 : 1e-9;
+      o.atol = o.rtol * 1e-7;  // the response is 5e-6 m and 1e-3 m/s
+      o.inputs = {InputSignal::step(U, ts)};
+      const SimulationResult r = run(model, o);
+      EXPECT_EQ(r.restarts, 1);
+      EXPECT_EQ(r.analytic_jacobian, c.method == mbsgen::IntegrationMethod::bdf && !c.quotients);
+      double worst_y = 0, worst_v = 0, size_y = 0, size_v = 0;
+      for (Eigen::Index k = 0; k < r.t.size(); ++k) {
+        const Eigen::VectorXd x = exact(r.t[k]);
+        worst_y = std::max(worst_y, (r.y.col(k) - x.head(n)).cwiseAbs().maxCoeff());
+        worst_v = std::max(worst_v, (r.yd.col(k) - x.tail(n)).cwiseAbs().maxCoeff());
+        size_y = std::max(size_y, x.head(n).cwiseAbs().maxCoeff());
+        size_v = std::max(size_v, x.tail(n).cwiseAbs().maxCoeff());
+        EXPECT_EQ(r.u(0, k), r.t[k] > ts ? U : 0.0);
+      }
+      error[tight] = std::max(worst_y / size_y, worst_v / size_v);
+    }
+    const std::string which = std::string(c.method == mbsgen::IntegrationMethod::bdf ? "bdf" : "adams") +
+                              (c.quotients ? " (difference quotients)" : "");
+    EXPECT_LT(error[1], 1e-7) << which << ": " << error[1] << " at rtol 1e-11";
+    EXPECT_LT(error[1], error[0] / 10) << which << ": " << error[0] << " at 1e-9, " << error[1] << " at 1e-11";
+  }
+}
+
+std::string failure_of(const GeneratedModel& model, SimulationOptions o, double* time = nullptr) {
+  try {
+    run(model, o);
+  } catch (const mbsgen::SimulationError& e) {
+    if (time) *time = e.time();
+    return e.what();
+  }
+  return "no failure";
+}
+
+// Failures carry the time and the cause; no result is returned.
+TEST(Simulation, FailuresAreReportedWithTheTime) {
+  {  // the spherical pendulum's M = m L² diag(1, sin²θ) is singular at the pole; the fallback path
+    GeneratedModel model(spherical_pendulum_conical::kernels());
+    EXPECT_EQ(model.kernels().dynamics_jacobian, nullptr);
+    SimulationOptions o;
+    o.initial = {{"theta", 0.0}, {"phi_dot", 0.0}};
+    double t = -1;
+    const std::string what = failure_of(model, o, &t);
+    EXPECT_NE(what.find("the mass matrix is singular"), std::string::npos) << what;
+    EXPECT_EQ(t, 0.0) << what;
+  }
+  GeneratedModel pendulum(simple_pendulum::kernels());
+  {  // rates so high that the velocity-squared terms overflow: non-finite kernel values at t = 0
+    GeneratedModel model(double_pendulum::kernels());
+    SimulationOptions o;
+    o.initial = {{"phi1_dot", 1e160}};
+    double t = -1;
+    const std::string what = failure_of(model, o, &t);
+    EXPECT_NE(what.find("non-finite"), std::string::npos) << what;
+    EXPECT_EQ(t, 0.0) << what;
+  }
+  {  // gravity of 1e300 m/s²: steps below the resolution of t
+    GeneratedModel model(simple_pendulum::kernels());
+    model.set("g", 1e300);
+    SimulationOptions o;
+    o.initial = {{"phi", 1.0}};
+    double t = -1;
+    const std::string what = failure_of(model, o, &t);
+    EXPECT_NE(what.find("step size"), std::string::npos) << what;
+    EXPECT_GE(t, 0.0) << what;
+  }
+  {  // more steps between two samples than allowed: a fast pendulum sampled once
+    GeneratedModel model(simple_pendulum::kernels());
+    model.set("g", 1e7);
+    SimulationOptions o;
+    o.method = mbsgen::IntegrationMethod::adams;
+    o.duration = 1000;
+    o.step = 1000;
+    o.initial = {{"phi", 1.0}};
+    double t = -1;
+    const std::string what = failure_of(model, o, &t);
+    EXPECT_NE(what.find("internal steps between two samples"), std::string::npos) << what;
+    EXPECT_GT(t, 0.0) << what;
+  }
+  SimulationOptions o;
+  o.initial = {{"psi", 1.0}};
+  EXPECT_THROW(run(pendulum, o), mbsgen::NameError);
+  o.initial = {{"phi", std::nan("")}};
+  EXPECT_THROW(run(pendulum, o), mbsgen::NonFiniteError);
+  o.initial.clear();
+  o.duration = -1;
+  EXPECT_THROW(run(pendulum, o), mbsgen::Error);
+  o.duration = 1;
+  o.rtol = 0;
+  EXPECT_THROW(run(pendulum, o), mbsgen::Error);
+  GeneratedModel dp(double_pendulum::kernels());
+  SimulationOptions two;
+  two.inputs = {InputSignal(), InputSignal()};  // the double pendulum has one input
+  EXPECT_THROW(run(dp, two), mbsgen::DimensionError);
+}
+
+// Input signals against their definitions.
+TEST(Simulation, InputSignals) {
+  EXPECT_EQ(InputSignal()(3.0), 0.0);
+  EXPECT_EQ(InputSignal::constant(2.5)(7.0), 2.5);
+  EXPECT_DOUBLE_EQ(InputSignal::sine(2, 5, kPi / 2, 1)(0.1), 1 + 2 * std::sin(kPi + kPi / 2));
+  const InputSignal step = InputSignal::step(3, 0.5, 1);
+  EXPECT_EQ(step(0.5), 1.0);
+  EXPECT_EQ(step(0.5000001), 4.0);
+  EXPECT_EQ(step.breakpoints(), std::vector<double>{0.5});
+  // chirp: phase 2π (f0 t + (f1 − f0) t²/(2T)), instantaneous frequency f0 + (f1 − f0) t/T
+  const InputSignal chirp = InputSignal::chirp(1, 10, 30, 2);
+  EXPECT_NEAR(chirp(0.75), std::sin(2 * kPi * (10 * 0.75 + 20 * 0.75 * 0.75 / 4)), 1e-12);
+  EXPECT_NEAR(chirp(2.5), std::sin(2 * kPi * (10 * 2 + 20 * 2.0 * 2.0 / 4 + 30 * 0.5)), 1e-12);
+  const InputSignal table = InputSignal::table({0, 1, 3}, {0, 2, -2});
+  EXPECT_EQ(table(-1), 0.0);
+  EXPECT_EQ(table(0.5), 1.0);
+  EXPECT_EQ(table(2), 0.0);
+  EXPECT_EQ(table(9), -2.0);
+  EXPECT_THROW(InputSignal::table({0, 0}, {1, 2}), mbsgen::Error);
+  EXPECT_THROW(InputSignal::table({0}, {1, 2}), mbsgen::DimensionError);
+  EXPECT_DOUBLE_EQ(InputSignal::parse("sine:2,5,90,1", 1)(0.1), 1 + 2 * std::sin(kPi + kPi / 2));
+  EXPECT_EQ(InputSignal::parse("step:3,0.5,1", 1)(0.6), 4.0);
+  EXPECT_EQ(InputSignal::parse("-1.5", 1)(0.6), -1.5);
+  EXPECT_NEAR(InputSignal::parse("chirp:1,10,30", 2)(0.75), chirp(0.75), 1e-15);
+  for (const char* bad : {"sine:1", "sine:1,2,3,4,5", "step:", "nope:1", "sine:1,x", "1e400", "table:/nonexistent.csv", ""})
+    EXPECT_THROW(InputSignal::parse(bad, 1), mbsgen::NameError) << bad;
 }
 
 }  // namespace

@@ -1,13 +1,16 @@
 // Time-domain simulation of the nonlinear equations of motion M(y) ÿ + k(y, ẏ) − q(y, ẏ, u) = 0
-// of a generated model (issue 18), by SUNDIALS IDA on the implicit first-order form
+// of a generated model (issue 18), by SUNDIALS CVODE on the explicit first-order form
 //
-//   F(t, x, x') = [ y' − v ; M(y) v' + (k − q)(y, v, u(t)) ] = 0,   x = (y, v),
+//   x' = (v, ÿ),   ÿ = −M(y)⁻¹ (k − q)(y, v, u(t)),   x = (y, v),
 //
-// with the iteration matrix ∂F/∂x + c_j ∂F/∂x' = [c_j I, −I; K_y, c_j M + K_v] from the generated
-// kernels `dynamics` and `dynamics_jacobian` (K_y = ∂(M ÿ + k − q)/∂y, K_v = ∂(k − q)/∂ẏ), or, for
-// kernels generated without them, from `mass_matrix`, `residual` and IDA's difference quotients
-// (SimulationResult::analytic_jacobian says which). docs/simulation.md explains the choice of
-// IDA over CVODE.
+// with an LU factorization of M at each right-hand side (a singular M is reported where it
+// occurs). Two methods: BDF (orders 1–5, for stiff models such as the middle ear) with Newton's
+// iteration on the Jacobian ∂x'/∂x = [0, I; −M⁻¹ K_y, −M⁻¹ K_v] from the generated kernel
+// `dynamics_jacobian` (K_y = ∂(M ÿ + k − q)/∂y at the current ÿ, K_v = ∂(k − q)/∂ẏ), or from
+// difference quotients for kernels generated without it; and Adams–Moulton (orders 1–12, with
+// fixed-point iteration) for non-stiff motion, where its higher order takes fewer and more
+// accurate steps (a pendulum, a conservative linkage). docs/simulation.md compares them and says
+// why CVODE rather than IDA.
 #pragma once
 
 #include <Eigen/Core>
@@ -65,7 +68,10 @@ class InputSignal {
   std::vector<double> t_, v_, breakpoints_;
 };
 
+enum class IntegrationMethod { bdf, adams };
+
 struct SimulationOptions {
+  IntegrationMethod method = IntegrationMethod::bdf;
   double duration = 1;  ///< s, > 0
   double step = 1e-2;   ///< output sampling, s, > 0; the last sample is at `duration`
   double rtol = 1e-8, atol = 1e-10;
@@ -74,7 +80,7 @@ struct SimulationOptions {
   std::vector<std::pair<std::string, double>> initial;
   /// One signal per input, in the kernels' order, or empty for all inputs zero.
   std::vector<InputSignal> inputs;
-  /// Use IDA's difference quotients even when the kernels have `dynamics_jacobian` (tests).
+  /// BDF: difference-quotient Jacobians even when the kernels have `dynamics_jacobian`.
   bool difference_quotients = false;
   /// Called after each output sample with its time (a progress bar).
   std::function<void(double)> progress;
@@ -85,8 +91,8 @@ struct SimulationResult {
   Eigen::MatrixXd y, yd;  ///< n_coordinates × samples
   Eigen::MatrixXd u;      ///< n_inputs × samples
   Eigen::MatrixXd z;      ///< n_outputs × samples (empty when the kernels give no outputs)
-  bool analytic_jacobian = false;  ///< iteration matrices from `dynamics_jacobian`
-  long steps = 0, residual_evaluations = 0, jacobian_evaluations = 0, error_test_failures = 0,
+  bool analytic_jacobian = false;  ///< BDF's Newton matrices from `dynamics_jacobian`
+  long steps = 0, rhs_evaluations = 0, jacobian_evaluations = 0, error_test_failures = 0,
        nonlinear_failures = 0, restarts = 0;
 };
 
