@@ -351,7 +351,8 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   // `simulate` needs the kernels of a time step (EmitOptions::dynamics: the dynamics Jacobian);
   // the other commands' solver is built without them, as they cost compile time.
   const bool dynamics = !args.empty() && args[0] == "simulate" && scene == "full";
-  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler + (dynamics ? "\0dynamics" : "");
+  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
+  if (dynamics) key += std::string(1, '\0') + "dynamics";
   for (const auto& a : tc.includes) key += '\0' + a;
   // A library or generator rebuilt in place (a developer's build tree) makes a new key: their size
   // and time of modification are part of it, so a solver is never linked against an older runtime

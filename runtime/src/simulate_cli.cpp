@@ -109,8 +109,8 @@ std::vector<Eigen::Index> shown(const std::vector<std::string>& names, const Sim
     const auto it = std::find(names.begin(), names.end(), s);
     if (it == names.end()) {
       std::string known;
-      for (const auto& n : names) known += " " + n;
-      throw NameError("--show '" + s + "': no such series (known:" + known + ")");
+      for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+      throw NameError("--show '" + s + "': no such series; known: " + known);
     }
     rows.push_back(it - names.begin());
   }
@@ -160,6 +160,7 @@ CLI::App* add_simulate(CLI::App& app, SimulateOptions& o) {
   s->add_option("--format", o.format, "output format")->check(CLI::IsMember({"csv", "json"}));
   s->add_option("--plot", o.plot, "plot chosen series against time (FILE.svg or FILE.png)");
   s->add_option("--show", o.show, "the series to plot (default: the outputs); repeatable");
+  s->add_flag("--statistics", o.statistics, "print the integrator's statistics on standard error");
   s->add_flag("--difference-quotients", o.difference_quotients,
               "iteration matrices from difference quotients even where the kernels give the Jacobian");
   return s;
@@ -193,13 +194,14 @@ int run_simulate(const ModelKernels& k, const SimulateOptions& o, std::ostream& 
     write_json(out, k, o, r, names, v);
   else
     write_csv(out, names, r.t, v);
-  err << "simulate: " << r.t.size() << " samples, " << o.method << ", " << r.steps << " steps, " << r.rhs_evaluations
-      << " right-hand sides";
-  if (o.method == "bdf")
-    err << ", " << r.jacobian_evaluations << " Jacobians (" << (r.analytic_jacobian ? "kernels" : "difference quotients")
-        << ")";
-  err << ", " << r.error_test_failures
-      << " error test failures, " << r.restarts << " restarts\n";
+  if (o.statistics) {
+    err << "simulate: " << r.t.size() << " samples, " << o.method << ", " << r.steps << " steps, "
+        << r.rhs_evaluations << " right-hand sides";
+    if (o.method == "bdf")
+      err << ", " << r.jacobian_evaluations << " Jacobians ("
+          << (r.analytic_jacobian ? "kernels" : "difference quotients") << ")";
+    err << ", " << r.error_test_failures << " error test failures, " << r.restarts << " restarts\n";
+  }
   if (!o.plot.empty()) err << "wrote " << o.plot << "\n";
   return 0;
 }

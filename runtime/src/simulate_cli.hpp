@@ -16,7 +16,7 @@ struct SimulateOptions {
   std::vector<std::string> set, initial, inputs, show;
   double duration = 0, step = 0, rtol = 1e-8, atol = 1e-10;
   std::string format = "csv", plot, method = "bdf";
-  bool difference_quotients = false;
+  bool difference_quotients = false, statistics = false;
 };
 
 /// Adds the subcommand `simulate` to app, its options stored in o.

@@ -213,8 +213,8 @@ void initial_state(const GeneratedModel& model, const OperatingPoint& op, const 
     }
     if (!found) {
       std::string known;
-      for (const auto& c : names) known += " " + c + " " + c + "_dot";
-      throw NameError("simulate: no coordinate or rate '" + name + "' (known:" + known + ")");
+      for (const auto& c : names) known += (known.empty() ? "" : ", ") + c + ", " + c + "_dot";
+      throw NameError("simulate: no coordinate or rate '" + name + "'; known: " + known);
     }
   }
 }

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -203,6 +204,46 @@ TEST(SolverCli, SpecialFilesAreRefused) {
   EXPECT_EQ(solve({"frf", "--input", "F", "--output", "tip_x", "--points", "3", "--plot", "/dev/null"}, nullptr, &err), 1);
   EXPECT_EQ(err, "double_pendulum-solve: error: --plot: refusing to write /dev/null: it is a device, not a "
                  "regular file\n");
+}
+
+// `simulate`: the CSV and JSON layouts, the plot, and the exit codes of bad names, bad signals
+// and a failed integration (nothing on standard output then).
+TEST(SolverCli, Simulate) {
+  std::string out, err;
+  ASSERT_EQ(solve({"simulate", "--duration", "1", "--step", "0.25", "--initial", "phi1=0.2", "--input", "F=sine:0.1,2"},
+                  &out, &err), 0) << err;
+  EXPECT_EQ(err, "");
+  std::istringstream csv(out);
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "t,phi1,phi2,phi1_dot,phi2_dot,tip_x,tip_vx,upper_angle,relative_angle");
+  int rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, 5);  // t = 0, 0.25, 0.5, 0.75, 1
+  ASSERT_EQ(solve({"simulate", "--duration", "0.5", "--step", "0.5", "--format", "json", "--method", "adams"}, &out, &err), 0);
+  EXPECT_EQ(out.rfind("{\"model\":\"double_pendulum\",\"scene\":\"full\",\"method\":\"adams\",\"jacobian\":\"none\"", 0), 0u) << out;
+  EXPECT_NE(out.find("\"t\":[0,0.5],\"series\":{\"phi1\":[0,0]"), std::string::npos) << out;
+  TempDir dir;
+  const std::string plot = (dir.path / "motion.svg").string();
+  ASSERT_EQ(solve({"simulate", "--duration", "1", "--initial", "phi1=0.5", "--plot", plot, "--show", "phi1", "--show",
+                   "tip_x"}, &out, &err), 0) << err;
+  EXPECT_EQ(err, "wrote " + plot + "\n");
+  std::ifstream svg(plot);
+  std::string head((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
+  EXPECT_NE(head.find("<svg"), std::string::npos);
+  EXPECT_NE(head.find("tip_x [m]"), std::string::npos);
+  EXPECT_EQ(solve({"simulate", "--duration", "1", "--plot", plot, "--show", "nope"}, &out, &err), 2);
+  EXPECT_EQ(err, "double_pendulum-solve: --show 'nope': no such series; known: phi1, phi2, phi1_dot, phi2_dot, tip_x, "
+                 "tip_vx, upper_angle, relative_angle\n");
+  EXPECT_EQ(solve({"simulate", "--duration", "1", "--input", "G=1"}, &out, &err), 2);
+  EXPECT_EQ(solve({"simulate", "--duration", "1", "--input", "F=sine:1"}, &out, &err), 2);
+  EXPECT_EQ(err, "double_pendulum-solve: input signal 'sine:1': expected sine:AMPLITUDE,HZ[,PHASE_DEG[,OFFSET]]\n");
+  EXPECT_EQ(solve({"simulate", "--duration", "-1"}, &out, &err), 2);
+  EXPECT_EQ(solve({"simulate", "--duration", "1", "--plot", "/dev/null"}, &out, &err), 1);
+  EXPECT_EQ(solve({"simulate", "--duration", "1", "--initial", "phi1_dot=1e160"}, &out, &err), 1);
+  EXPECT_EQ(out, "");
+  EXPECT_EQ(err.rfind("double_pendulum-solve: error: simulate: the initial state fails at t = 0 s: the kernels returned "
+                      "non-finite values", 0), 0u) << err;
 }
 
 // Same rules and messages as `mbsgen linear frf` (tests/runtime/test_cli.cpp), and the limit on
