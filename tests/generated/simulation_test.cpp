@@ -352,45 +352,21 @@ TEST(Simulation, InputSignals) {
 }
 
 
-// A sine u = A sin Ωt on input `input`, from the linear steady state (y = y0 + Im(ŷ e^{iΩt}),
-// ŷ = (K − Ω²M + iΩQ)⁻¹ B A by Eigen's complex LU): the complex amplitude of output `output` over
-// the last `fit` of `periods` periods (least squares on sin, cos and a constant), divided by the
-// frequency response's A·G (FrequencyResponse, the runtime's method), minus 1.
+// The fundamental of output `output` under A sin Ωt on `input` (sine_response: from the linear
+// steady state, fitted over the last `fit` of `periods` periods), divided by the frequency
+// response's A·G (FrequencyResponse, the runtime's method), minus 1.
 std::complex<double> sine_against_frf(const GeneratedModel& model, Eigen::Index input, Eigen::Index output, double hz,
                                       double A, int periods, int fit, double rtol) {
   const mbsgen::OperatingPoint op = model.operating_point();
-  const mbsgen::LinearModel lin = model.linear_model(op);
-  const double w = 2 * kPi * hz;
-  const std::complex<double> i(0, 1);
-  const Eigen::MatrixXcd D = lin.K().cast<std::complex<double>>() - w * w * lin.M().cast<std::complex<double>>() +
-                             i * w * lin.Q().cast<std::complex<double>>();
-  const Eigen::VectorXcd yhat = D.lu().solve(A * lin.B().col(input).cast<std::complex<double>>());
-  SimulationOptions o;
-  o.duration = periods / hz;
-  o.step = 1 / (hz * 64);
+  mbsgen::SineResponseOptions o;
+  o.periods = periods;
+  o.fit_periods = fit;
   o.rtol = rtol;
-  o.atol = rtol * 1e-3 * yhat.cwiseAbs().maxCoeff();  // a thousandth of the motion's size
-  const auto names = mbsgen::name_list(model.kernels().coordinate_names, model.kernels().n_coordinates);
-  for (std::size_t c = 0; c < names.size(); ++c) {
-    const auto k = static_cast<Eigen::Index>(c);
-    o.initial.emplace_back(names[c], op.y0[k] + yhat[k].imag());
-    o.initial.emplace_back(names[c] + "_dot", op.yd0[k] + w * yhat[k].real());
-  }
-  o.inputs.resize(static_cast<std::size_t>(model.kernels().n_inputs));
-  o.inputs[static_cast<std::size_t>(input)] = InputSignal::sine(A, hz);
-  const SimulationResult r = simulate(model, op, o);
-  const Eigen::Index first = r.t.size() - 1 - fit * 64;
-  Eigen::MatrixXd X(r.t.size() - first, 3);
-  Eigen::VectorXd z(r.t.size() - first);
-  for (Eigen::Index k = first; k < r.t.size(); ++k) {
-    X.row(k - first) << std::sin(w * r.t[k]), std::cos(w * r.t[k]), 1.0;
-    z[k - first] = r.z(output, k);
-  }
-  const Eigen::Vector3d abc = X.colPivHouseholderQr().solve(z);
+  const mbsgen::SineResponse s = mbsgen::sine_response(model, op, input, hz, A, o);
+  const mbsgen::LinearModel lin = model.linear_model(op);
   mbsgen::FrequencyResponse frf(lin);
-  frf.compute(Eigen::VectorXd::Constant(1, w), input, {output});
-  const std::complex<double> G = frf.response()(0, 0);
-  return std::complex<double>(abc[0], abc[1]) / (A * G) - 1.0;
+  frf.compute(Eigen::VectorXd::Constant(1, 2 * kPi * hz), input, {output});
+  return s.fundamental[output] / (A * frf.response()(0, 0)) - 1.0;
 }
 
 struct SineCase {

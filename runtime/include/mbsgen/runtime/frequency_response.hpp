@@ -126,6 +126,9 @@ class FrequencyResponse {
  public:
   /// Keeps a reference to `model` (f coordinates) and the options; allocates nothing large yet.
   explicit FrequencyResponse(const LinearModel& model, FrfOptions options = {});
+  /// Refused at compile time: the reference would dangle once the temporary is gone
+  /// (`FrequencyResponse frf(model.linear_model())` crashed in compute()).
+  explicit FrequencyResponse(LinearModel&& model, FrfOptions options = {}) = delete;
   ~FrequencyResponse();  ///< defined where Impl is complete
   FrequencyResponse(const FrequencyResponse&) = delete;
   FrequencyResponse& operator=(const FrequencyResponse&) = delete;

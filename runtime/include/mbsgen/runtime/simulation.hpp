@@ -102,4 +102,35 @@ struct SimulationResult {
 /// nonholonomic model), SimulationError when the integration fails.
 SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op, const SimulationOptions& options);
 
+struct SineResponseOptions {
+  IntegrationMethod method = IntegrationMethod::bdf;
+  int periods = 20;              ///< simulated periods
+  int fit_periods = 10;          ///< the last ones, over which the fundamental is fitted
+  int samples_per_period = 64;
+  double rtol = 1e-9;
+  /// atol = rtol × atol_fraction × the largest entry of the linear steady state's |ŷ|: the
+  /// motion's size sets what "absolute" means (the middle ear's is nanometres).
+  double atol_fraction = 1e-3;
+};
+
+/// The steady state of the nonlinear model under u_input = A sin(2π f t) (the other inputs 0).
+struct SineResponse {
+  /// Per output, the complex amplitude Z of its fundamental, z ≈ c + Im(Z e^{iΩt}) (so Z/A is
+  /// the frequency response's value when the model is linear), and the constant c.
+  Eigen::VectorXcd fundamental;
+  Eigen::VectorXd offset;
+  /// Per output, the RMS of what the fit leaves (harmonics, the rest of the transient) relative
+  /// to |Z|.
+  Eigen::VectorXd distortion;
+  long steps = 0;
+};
+
+/// Integrates from the linear steady state y = y0 + Im(ŷ e^{iΩt}), ŷ = (K − Ω²M + iΩQ)⁻¹ B A
+/// (so that only the nonlinearity's own transient remains) over options.periods periods and fits
+/// the outputs' fundamentals by least squares over the last fit_periods. Throws like simulate(),
+/// DimensionError for a bad input index, Error for a model without outputs or a non-positive
+/// frequency or amplitude.
+SineResponse sine_response(const GeneratedModel& model, const OperatingPoint& op, Eigen::Index input, double hz,
+                           double amplitude, const SineResponseOptions& options = {});
+
 }  // namespace mbsgen
