@@ -305,6 +305,8 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
   KernelsAhead ahead = progress.paused([&] { return emit_ahead(model, options); });
   progress.stage("deriving the equations");
   Equations& eq = kept_until_exit<Equations>([&] { return derive(model); });
+  // A model with rolling constraints has no second-order form: its solver refuses `simulate`.
+  if (eq.nonholonomic.active) options.dynamics = false;
   progress.stage("linearizing");
   LinearEquations& lin = kept_until_exit<LinearEquations>([&] { return linearize(eq); });
   progress.stage("checking the operating point");

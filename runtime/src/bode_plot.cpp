@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -228,7 +229,9 @@ std::string time_script(const std::string& terminal, const Eigen::VectorXd& t, c
                         const TimePlot& plot) {
   std::ostringstream s;
   s << "set terminal " << terminal << "\n$series << EOD\n";
-  for (Eigen::Index k = 0; k < t.size(); ++k) {
+  // At most about 20,000 points a series (more do not show, and the script is held in memory).
+  const Eigen::Index stride = std::max<Eigen::Index>(1, t.size() / 20000);
+  for (Eigen::Index k = 0; k < t.size(); k += stride) {
     char field[32];
     std::snprintf(field, sizeof field, "%.17g", t[k]);
     s << field;

@@ -1,5 +1,6 @@
 // Inputs as functions of time for simulate() (simulation.hpp).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -27,10 +28,21 @@ double number_in(const std::string& text, const std::string& spec) {
 
 std::vector<double> numbers_in(const std::string& list, const std::string& spec) {
   std::vector<double> v;
-  std::stringstream s(list);
-  std::string item;
-  while (std::getline(s, item, ',')) v.push_back(number_in(item, spec));
-  return v;
+  std::size_t start = 0;
+  while (true) {  // every field, the empty ones too ("1,,2" and "1,2," are refused)
+    const std::size_t comma = list.find(',', start);
+    v.push_back(number_in(list.substr(start, comma == std::string::npos ? std::string::npos : comma - start), spec));
+    if (comma == std::string::npos) return v;
+    start = comma + 1;
+  }
+}
+
+// A header: a first field that does not start like a number (sign, digit or point).
+bool header_line(const std::string& line) {
+  const auto first = line.find_first_not_of(" \t");
+  if (first == std::string::npos) return false;
+  const char c = line[first];
+  return !(std::isdigit(static_cast<unsigned char>(c)) || c == '+' || c == '-' || c == '.');
 }
 
 // Reads a CSV table of t,value lines (a first line that is not numbers is a header).
@@ -41,7 +53,9 @@ InputSignal table_from_file(const std::string& path, const std::string& spec) {
   std::string line;
   for (long number = 1; std::getline(in, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte order mark
     if (line.empty() || line[0] == '#') continue;
+    if (number == 1 && header_line(line)) continue;
     const auto comma = line.find(',');
     const std::string where = path + ":" + std::to_string(number);
     if (comma == std::string::npos) throw NameError(where + ": expected 't,value'");
@@ -49,7 +63,6 @@ InputSignal table_from_file(const std::string& path, const std::string& spec) {
       t.push_back(number_in(line.substr(0, comma), spec));
       v.push_back(number_in(line.substr(comma + 1), spec));
     } catch (const NameError&) {
-      if (number == 1 && t.empty()) continue;  // a header
       throw NameError(where + ": expected 't,value' with finite numbers, got '" + line + "'");
     }
   }

@@ -52,11 +52,11 @@ SimulationOptions simulation_options(const GeneratedModel& model, const Simulate
   return s;
 }
 
-// The series' names: t, the coordinates, their rates, the outputs (when the kernels give them).
-std::vector<std::string> series_names(const ModelKernels& k, const SimulationResult& r) {
+// The series' names: the coordinates, their rates, the outputs (when the kernels give them).
+std::vector<std::string> series_names(const ModelKernels& k) {
   std::vector<std::string> names = name_list(k.coordinate_names, k.n_coordinates);
   for (int i = 0; i < k.n_coordinates; ++i) names.push_back(names[static_cast<std::size_t>(i)] + "_dot");
-  if (r.z.size() > 0)
+  if (simulates_outputs(k))
     for (const auto& z : name_list(k.output_names, k.n_outputs)) names.push_back(z);
   return names;
 }
@@ -89,9 +89,12 @@ void write_json(std::ostream& out, const ModelKernels& k, const SimulateOptions&
   out << "{\"model\":" << json_string(k.model) << ",\"scene\":" << json_string(k.scene)
       << ",\"method\":" << json_string(o.method) << ",\"jacobian\":"
       << json_string(o.method == "adams" ? "none" : r.analytic_jacobian ? "kernels" : "difference quotients")
-      << ",\"statistics\":{\"steps\":" << r.steps << ",\"rhs_evaluations\":" << r.rhs_evaluations
-      << ",\"jacobian_evaluations\":" << r.jacobian_evaluations << ",\"error_test_failures\":" << r.error_test_failures
-      << ",\"nonlinear_failures\":" << r.nonlinear_failures << ",\"restarts\":" << r.restarts << "},\"t\":";
+      << ",\"restarts\":" << r.restarts;
+  if (o.statistics)  // counts that vary with the SUNDIALS version and the libm: asked for only
+    out << ",\"statistics\":{\"steps\":" << r.steps << ",\"rhs_evaluations\":" << r.rhs_evaluations
+        << ",\"jacobian_evaluations\":" << r.jacobian_evaluations << ",\"error_test_failures\":" << r.error_test_failures
+        << ",\"nonlinear_failures\":" << r.nonlinear_failures << "}";
+  out << ",\"t\":";
   row([&](Eigen::Index j) { return r.t[j]; }, r.t.size());
   out << ",\"series\":{";
   for (std::size_t i = 0; i < names.size(); ++i) {
@@ -102,8 +105,7 @@ void write_json(std::ostream& out, const ModelKernels& k, const SimulateOptions&
 }
 
 // The series --show names (default: the outputs, or the coordinates when there are none).
-std::vector<Eigen::Index> shown(const std::vector<std::string>& names, const SimulateOptions& o, const ModelKernels& k,
-                                const SimulationResult& r) {
+std::vector<Eigen::Index> shown(const std::vector<std::string>& names, const SimulateOptions& o, const ModelKernels& k) {
   std::vector<Eigen::Index> rows;
   for (const std::string& s : o.show) {
     const auto it = std::find(names.begin(), names.end(), s);
@@ -115,8 +117,9 @@ std::vector<Eigen::Index> shown(const std::vector<std::string>& names, const Sim
     rows.push_back(it - names.begin());
   }
   if (rows.empty()) {
-    const Eigen::Index first = r.z.size() > 0 ? 2 * k.n_coordinates : 0;
-    const Eigen::Index count = r.z.size() > 0 ? k.n_outputs : k.n_coordinates;
+    const bool outputs = simulates_outputs(k) && k.n_outputs > 0;
+    const Eigen::Index first = outputs ? 2 * k.n_coordinates : 0;
+    const Eigen::Index count = outputs ? k.n_outputs : k.n_coordinates;
     for (Eigen::Index i = 0; i < std::min(count, kMaxTimePanels); ++i) rows.push_back(first + i);
   }
   if (static_cast<Eigen::Index>(rows.size()) > kMaxTimePanels)
@@ -125,8 +128,7 @@ std::vector<Eigen::Index> shown(const std::vector<std::string>& names, const Sim
 }
 
 void plot(const SimulateOptions& o, const ModelKernels& k, const SimulationResult& r,
-          const std::vector<std::string>& names, const Eigen::MatrixXd& v) {
-  const std::vector<Eigen::Index> rows = shown(names, o, k, r);
+          const std::vector<std::string>& names, const std::vector<Eigen::Index>& rows, const Eigen::MatrixXd& v) {
   TimePlot p;
   p.title = std::string(k.model) + " (" + k.scene + "): simulation";
   Eigen::MatrixXd values(static_cast<Eigen::Index>(rows.size()), v.cols());
@@ -139,6 +141,16 @@ void plot(const SimulateOptions& o, const ModelKernels& k, const SimulationResul
     p.labels.push_back(label);
   }
   write_time_plot(o.plot, r.t, values, p);
+}
+
+void print_statistics(std::ostream& err, const SimulateOptions& o, const SimulationResult& r) {
+  err << "simulate: " << r.t.size() << " samples, " << o.method << ", " << r.steps << " steps, " << r.rhs_evaluations
+      << " right-hand sides";
+  if (o.method == "bdf")
+    err << ", " << r.jacobian_evaluations << " Jacobians (" << (r.analytic_jacobian ? "kernels" : "difference quotients")
+        << ")";
+  err << ", " << r.error_test_failures << " error test failures, " << r.nonlinear_failures
+      << " corrector failures, " << r.restarts << " restarts\n";
 }
 
 }  // namespace
@@ -172,36 +184,39 @@ int run_simulate(const ModelKernels& k, const SimulateOptions& o, std::ostream& 
   if (model.is_descriptor())
     throw Error("simulate: model '" + std::string(k.model) + "' has nonholonomic constraints; its kernels are the "
                 "linearization's descriptor form, and time integration of such models is not available yet");
-  if (!o.plot.empty()) refuse_special_file(o.plot, "--plot");  // before the run, not after
   SimulationOptions s = simulation_options(model, o);
+  const std::vector<std::string> names = series_names(k);
+  std::vector<Eigen::Index> rows;
+  if (!o.plot.empty()) {  // before the run, not after
+    refuse_special_file(o.plot, "--plot");
+    rows = shown(names, o, k);
+  }
   const bool terminal = ::isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
-  bool shown_progress = false;
+  bool progress_shown = false;
   s.progress = [&](double t) {
     if (!terminal || std::chrono::steady_clock::now() - start < std::chrono::seconds(2)) return;
     err << "\rsimulate: t = " << short_num(t) << " s (" << static_cast<int>(100 * t / s.duration) << " %)" << std::flush;
-    shown_progress = true;
+    progress_shown = true;
   };
   if (o.method == "bdf" && !k.dynamics_jacobian && !o.difference_quotients)
     err << "note: the kernels have no dynamics_jacobian (generate with --dynamics): iteration matrices from "
            "difference quotients\n";
-  const SimulationResult r = simulate(model, model.operating_point(), s);
-  if (shown_progress) err << "\r" << std::string(40, ' ') << "\r";
-  const std::vector<std::string> names = series_names(k, r);
+  SimulationResult r;
+  try {
+    r = simulate(model, model.operating_point(), s);
+  } catch (...) {
+    if (progress_shown) err << "\r" << std::string(40, ' ') << "\r";
+    throw;
+  }
+  if (progress_shown) err << "\r" << std::string(40, ' ') << "\r";
   const Eigen::MatrixXd v = series_values(r);
-  if (!o.plot.empty()) plot(o, k, r, names, v);
+  if (!o.plot.empty()) plot(o, k, r, names, rows, v);
   if (o.format == "json")
     write_json(out, k, o, r, names, v);
   else
     write_csv(out, names, r.t, v);
-  if (o.statistics) {
-    err << "simulate: " << r.t.size() << " samples, " << o.method << ", " << r.steps << " steps, "
-        << r.rhs_evaluations << " right-hand sides";
-    if (o.method == "bdf")
-      err << ", " << r.jacobian_evaluations << " Jacobians ("
-          << (r.analytic_jacobian ? "kernels" : "difference quotients") << ")";
-    err << ", " << r.error_test_failures << " error test failures, " << r.restarts << " restarts\n";
-  }
+  if (o.statistics) print_statistics(err, o, r);
   if (!o.plot.empty()) err << "wrote " << o.plot << "\n";
   return 0;
 }

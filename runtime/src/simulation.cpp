@@ -26,6 +26,9 @@ using Eigen::VectorXd;
 
 // Internal steps allowed between two output samples before the run is reported as stuck.
 constexpr long kMaxStepsPerSample = 200000;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// The most values (samples × (coordinates, rates, inputs, outputs)) a run keeps: 400 MB.
+constexpr double kMaxValues = 5e7;
 
 std::string short_number(double v) {
   std::ostringstream s;
@@ -52,6 +55,17 @@ struct Cvode {
   Cvode(const Cvode&) = delete;
   Cvode& operator=(const Cvode&) = delete;
   Cvode(sunindextype size, IntegrationMethod method) {
+    try {
+      create(size, method);
+    } catch (...) {
+      release();
+      throw;
+    }
+  }
+  ~Cvode() { release(); }
+
+ private:
+  void create(sunindextype size, IntegrationMethod method) {
     if (SUNContext_Create(nullptr, &context) != 0) throw Error("simulate: SUNContext_Create failed");
     x = N_VNew_Serial(size, context);
     mem = CVodeCreate(method == IntegrationMethod::adams ? CV_ADAMS : CV_BDF, context);
@@ -65,7 +79,7 @@ struct Cvode {
       if (!solver) throw Error("simulate: SUNLinSol_Dense failed");
     }
   }
-  ~Cvode() {
+  void release() {
     if (mem) CVodeFree(&mem);
     if (fixed_point) SUNNonlinSolFree(fixed_point);
     if (solver) SUNLinSolFree(solver);
@@ -89,11 +103,20 @@ class Equations {
     return options_.method == IntegrationMethod::bdf && k_.dynamics_jacobian && !options_.difference_quotients;
   }
 
+  // The inputs at t; at the start of a segment (t = 0, or a breakpoint where the integrator
+  // restarted) their value just after it, so that a step at the start acts from the start.
   const VectorXd& inputs(double t) {
+    const double at = t <= segment_start_ ? std::nextafter(segment_start_, kInfinity) : t;
+    for (Index i = 0; i < u_.size(); ++i)
+      u_[i] = options_.inputs.empty() ? 0.0 : options_.inputs[static_cast<std::size_t>(i)](at);
+    return u_;
+  }
+  const VectorXd& inputs_at(double t) {  // the signals' own values (left-continuous at a step)
     for (Index i = 0; i < u_.size(); ++i)
       u_[i] = options_.inputs.empty() ? 0.0 : options_.inputs[static_cast<std::size_t>(i)](t);
     return u_;
   }
+  void start_segment(double t) { segment_start_ = t; }
   // M, k − q and ÿ at (y, ẏ, u(t)); false (with the reason kept) when a kernel fails or M is
   // singular there.
   bool evaluate(double t, const double* y, const double* yd) {
@@ -111,29 +134,38 @@ class Equations {
     // inf or NaN): the pivots' ratio bounds the reciprocal condition number from above.
     double rcond = 1.0;
     if (n_ > 0) {
-      const VectorXd pivots = lu_.matrixLU().diagonal().cwiseAbs();
-      rcond = std::min(lu_.rcond(), pivots.minCoeff() / pivots.maxCoeff());
+      double smallest = kInfinity, largest = 0;
+      for (Index i = 0; i < n_; ++i) {
+        const double d = std::abs(lu_.matrixLU()(i, i));
+        smallest = std::min(smallest, d), largest = std::max(largest, d);
+      }
+      rcond = smallest / largest;
+      if (rcond > static_cast<double>(n_) * std::numeric_limits<double>::epsilon()) rcond = std::min(rcond, lu_.rcond());
     }
     if (!(rcond > static_cast<double>(n_) * std::numeric_limits<double>::epsilon())) {
       rcond_ = rcond;
       return fail(t, Failure::singular_mass);
     }
-    a_ = lu_.solve(-r_);
+    a_.noalias() = lu_.solve(r_);
+    a_ = -a_;
+    if (!a_.allFinite()) return fail(t, Failure::non_finite);
     return true;
   }
   // ∂ÿ/∂y = −M⁻¹ K_y(y, ẏ, ÿ) and ∂ÿ/∂ẏ = −M⁻¹ K_v after evaluate() at the same state.
   bool jacobian(double t, const double* y, const double* yd, Eigen::Ref<MatrixXd> dy, Eigen::Ref<MatrixXd> dv) {
     if (k_.dynamics_jacobian(y, yd, a_.data(), u_.data(), p_.data(), Ky_.data(), Kv_.data()) != 0)
       return fail(t, Failure::non_finite);
-    dy = -lu_.solve(Ky_);
-    dv = -lu_.solve(Kv_);
-    return true;
+    Ky_ = -Ky_;
+    Kv_ = -Kv_;
+    dy = lu_.solve(Ky_);
+    dv = lu_.solve(Kv_);
+    return dy.allFinite() && dv.allFinite() ? true : fail(t, Failure::non_finite);
   }
   const VectorXd& accelerations() const { return a_; }
   const std::vector<double>& parameters() const { return p_; }
 
-  enum class Failure { none, non_finite, loops, singular_mass };
-  Failure failure = Failure::none;  // the first failure of the current attempt, for the message
+  enum class Failure { none, non_finite, loops, singular_mass, exception };
+  Failure failure = Failure::none;  // the last failure in the current CVode call, for the message
   double failed_time = 0;
   std::string reason() const {
     switch (failure) {
@@ -144,6 +176,8 @@ class Equations {
       case Failure::singular_mass:
         return "the mass matrix is singular (reciprocal condition number " + short_number(rcond_) +
                "): no unique accelerations";
+      case Failure::exception:
+        return "out of memory in the right-hand side or its Jacobian";
       case Failure::none:
         break;
     }
@@ -164,35 +198,51 @@ class Equations {
   VectorXd r_, u_, a_;
   MatrixXd Ky_, Kv_;
   Eigen::PartialPivLU<MatrixXd> lu_;
-  double rcond_ = 0;
+  double rcond_ = 0, segment_start_ = 0;
 };
 
 // x' = (v, ÿ(y, v, u(t))).
-int rhs_function(realtype t, N_Vector x, N_Vector xp, void* data) {
+int rhs_function(realtype t, N_Vector x, N_Vector xp, void* data) noexcept {
   auto& eq = *static_cast<Equations*>(data);
-  const Index n = eq.size();
-  const double* xs = N_VGetArrayPointer(x);
-  double* f = N_VGetArrayPointer(xp);
-  if (!eq.evaluate(t, xs, xs + n)) return 1;  // recoverable: CVODE retries with a smaller step
-  Eigen::Map<VectorXd>(f, n) = Eigen::Map<const VectorXd>(xs + n, n);
-  Eigen::Map<VectorXd>(f + n, n) = eq.accelerations();
-  return 0;
+  try {
+    const Index n = eq.size();
+    const double* xs = N_VGetArrayPointer(x);
+    double* f = N_VGetArrayPointer(xp);
+    if (!eq.evaluate(t, xs, xs + n)) return 1;  // recoverable: CVODE retries with a smaller step
+    Eigen::Map<VectorXd>(f, n) = Eigen::Map<const VectorXd>(xs + n, n);
+    Eigen::Map<VectorXd>(f + n, n) = eq.accelerations();
+    return 0;
+  } catch (...) {  // nothing may unwind through CVODE's C frames
+    eq.failure = Equations::Failure::exception;
+    eq.failed_time = t;
+    return -1;
+  }
 }
 
 // ∂x'/∂x = [0, I; −M⁻¹ K_y, −M⁻¹ K_v], with K_y at ÿ = x'[n:] (the right-hand side CVODE passes).
-int jacobian_function(realtype t, N_Vector x, N_Vector, SUNMatrix J, void* data, N_Vector, N_Vector, N_Vector) {
+int jacobian_function(realtype t, N_Vector x, N_Vector, SUNMatrix J, void* data, N_Vector, N_Vector,
+                      N_Vector) noexcept {
   auto& eq = *static_cast<Equations*>(data);
-  const Index n = eq.size();
-  const double* xs = N_VGetArrayPointer(x);
-  if (!eq.evaluate(t, xs, xs + n)) return 1;
-  Eigen::Map<MatrixXd> A(SM_DATA_D(J), 2 * n, 2 * n);
-  A.setZero();
-  A.topRightCorner(n, n).diagonal().setOnes();
-  return eq.jacobian(t, xs, xs + n, A.bottomLeftCorner(n, n), A.bottomRightCorner(n, n)) ? 0 : 1;
+  try {
+    const Index n = eq.size();
+    const double* xs = N_VGetArrayPointer(x);
+    if (!eq.evaluate(t, xs, xs + n)) return 1;
+    Eigen::Map<MatrixXd> A(SM_DATA_D(J), 2 * n, 2 * n);
+    A.setZero();
+    A.topRightCorner(n, n).diagonal().setOnes();
+    return eq.jacobian(t, xs, xs + n, A.bottomLeftCorner(n, n), A.bottomRightCorner(n, n)) ? 0 : 1;
+  } catch (...) {
+    eq.failure = Equations::Failure::exception;
+    eq.failed_time = t;
+    return -1;
+  }
 }
 
-void error_handler(int, const char*, const char*, char* message, void* data) {
-  *static_cast<std::string*>(data) = message ? message : "";
+void error_handler(int, const char*, const char*, char* message, void* data) noexcept {
+  try {
+    *static_cast<std::string*>(data) = message ? message : "";
+  } catch (...) {  // out of memory for the message: report without it
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -233,7 +283,11 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   positive(o.step, "the output step");
   positive(o.rtol, "rtol");
   positive(o.atol, "atol");
-  if (o.duration / o.step > 1e8) throw Error("simulate: more than 10^8 output samples (duration / step)");
+  const double values = (o.duration / o.step + 1) * (2.0 * k.n_coordinates + k.n_inputs + k.n_outputs);
+  if (values > kMaxValues)
+    throw Error("simulate: " + short_number(o.duration / o.step + 1) + " samples of " +
+                std::to_string(2 * k.n_coordinates + k.n_inputs + k.n_outputs) + " values each are more than " +
+                short_number(kMaxValues) + " values (400 MB): sample less often (--step) or simulate less time");
   if (!o.inputs.empty() && o.inputs.size() != static_cast<std::size_t>(k.n_inputs))
     throw DimensionError("simulate: " + std::to_string(o.inputs.size()) + " input signals for " +
                          std::to_string(k.n_inputs) + " inputs");
@@ -260,15 +314,24 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
       why = "the corrector iteration failed to converge repeatedly";
       break;
     default: {
-      double h = 0;
-      CVodeGetLastStep(cv.mem, &h);
-      why = std::abs(h) <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t))
-                ? "the step size fell to " + short_number(h) + " s, below the resolution of t: the motion is too fast "
-                  "there (forces or parameters far out of range?)"
-                : "the integrator failed (CVODE flag " + std::to_string(flag) + ")";
+      double last = 0, next = 0;
+      CVodeGetLastStep(cv.mem, &last);
+      CVodeGetCurrentStep(cv.mem, &next);
+      const double h = last != 0 ? last : next;
+      const bool stuck = h != 0 && std::abs(h) <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t));
+      const bool lost = flag == CV_BAD_T || flag == CV_ILL_INPUT;  // from its own interpolation
+      why = stuck ? "the integrator cannot advance (step size " + short_number(h) +
+                        " s): the motion is too fast there (forces or parameters far out of range?)"
+            : lost ? "the integrator lost control of its step size (step " + short_number(h) +
+                         " s): the forces or parameters are far out of range?"
+                  : "the integrator failed (CVODE flag " + std::to_string(flag) + ")";
     }
   }
-  if (eq.failure != Equations::Failure::none) {  // the cause the kernels or M gave
+  // The cause the kernels or M gave, where the failure is theirs (not for a tolerance that cannot
+  // be met: a failed evaluation CVODE recovered from may be recorded before it).
+  const bool theirs = flag == CV_RHSFUNC_FAIL || flag == CV_FIRST_RHSFUNC_ERR || flag == CV_REPTD_RHSFUNC_ERR ||
+                      flag == CV_UNREC_RHSFUNC_ERR || flag == CV_LSETUP_FAIL || flag == CV_CONV_FAILURE;
+  if (theirs && eq.failure != Equations::Failure::none) {
     t = eq.failed_time;
     why = eq.reason();
   }
@@ -305,8 +368,8 @@ void record(SimulationResult& r, Index j, double t, Cvode& cv, Equations& eq) {
   r.yd.col(j) = Eigen::Map<const VectorXd>(x + n, n);
   if (!r.y.col(j).allFinite() || !r.yd.col(j).allFinite())
     throw SimulationError("simulate: the state is not finite " + at_time(t), t);
-  r.u.col(j) = eq.inputs(t);
-  if (r.z.size() == 0) return;
+  r.u.col(j) = eq.inputs_at(t);
+  if (r.z.rows() == 0) return;
   const std::vector<double>& p = eq.parameters();
   int status = 0;
   if (k.outputs_general) {
@@ -319,23 +382,18 @@ void record(SimulationResult& r, Index j, double t, Cvode& cv, Equations& eq) {
   if (status != 0) throw SimulationError("simulate: the outputs are not finite " + at_time(t), t);
 }
 
-// The breakpoints of the inputs inside (0, duration).
-std::vector<double> breakpoints(const SimulationOptions& o) {
-  std::set<double> b;
-  for (const InputSignal& s : o.inputs)
-    for (double t : s.breakpoints())
-      if (t > 0 && t < o.duration) b.insert(t);
-  return {b.begin(), b.end()};
-}
-
 void add_statistics(Cvode& cv, SimulationResult& r) {
   long v = 0;
   CVodeGetNumSteps(cv.mem, &v), r.steps += v;
   CVodeGetNumRhsEvals(cv.mem, &v), r.rhs_evaluations += v;
-  if (cv.solver) CVodeGetNumJacEvals(cv.mem, &v), r.jacobian_evaluations += v;
+  if (cv.solver) {
+    CVodeGetNumJacEvals(cv.mem, &v), r.jacobian_evaluations += v;
+    CVodeGetNumLinRhsEvals(cv.mem, &v), r.rhs_evaluations += v;  // difference-quotient Jacobians
+  }
   CVodeGetNumErrTestFails(cv.mem, &v), r.error_test_failures += v;
   CVodeGetNumNonlinSolvConvFails(cv.mem, &v), r.nonlinear_failures += v;
 }
+
 
 SimulationResult allocated(const ModelKernels& k, Index samples) {
   SimulationResult r;
@@ -343,11 +401,56 @@ SimulationResult allocated(const ModelKernels& k, Index samples) {
   r.y.resize(k.n_coordinates, samples);
   r.yd.resize(k.n_coordinates, samples);
   r.u.resize(k.n_inputs, samples);
-  if (k.outputs || k.outputs_general) r.z.resize(k.n_outputs, samples);
+  r.z.resize(simulates_outputs(k) ? k.n_outputs : 0, samples);
   return r;
 }
 
+// Where the integrator stops: at every input step (restarting there, as its history holds the
+// old input) and at every knot of an input table (so that no knot is stepped over).
+struct Stop {
+  double t;
+  bool restart;
+};
+
+// Times closer than this are one: a millionth of the output step, or a few ulps of t.
+double window(const SimulationOptions& o, double t) {
+  return std::max(1e-9 * o.step, 16 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t)));
+}
+
+std::vector<Stop> stop_times(const SimulationOptions& o) {
+  std::vector<Stop> all;
+  for (const InputSignal& s : o.inputs) {
+    for (double t : s.breakpoints()) all.push_back({t, true});
+    for (double t : s.knots()) all.push_back({t, false});
+  }
+  std::sort(all.begin(), all.end(), [](const Stop& a, const Stop& b) { return a.t < b.t; });
+  std::vector<Stop> stops;
+  for (const Stop& s : all) {
+    if (!(s.t > window(o, 0)) || s.t >= o.duration - window(o, o.duration)) continue;  // inside (0, duration)
+    if (!stops.empty() && s.t - stops.back().t <= window(o, s.t))
+      stops.back().restart = stops.back().restart || s.restart;
+    else
+      stops.push_back(s);
+  }
+  return stops;
+}
+
+// After a jump of an input at t: the new segment's inputs are those just after t.
+void restart(Cvode& cv, Equations& eq, SimulationResult& r, double t) {
+  add_statistics(cv, r);
+  eq.start_segment(t);
+  if (CVodeReInit(cv.mem, t, cv.x) != CV_SUCCESS)
+    throw SimulationError("simulate: cannot restart at t = " + short_number(t) + " s (internal error)", t);
+  ++r.restarts;
+}
+
+Index sample_count(const SimulationOptions& o) { return static_cast<Index>(std::ceil(o.duration / o.step * (1 - 1e-12))) + 1; }
+
 }  // namespace
+
+// Kernels generated before `outputs_general` was in the descriptor have `output_terms` but not
+// it: their `outputs` would give static loads as if dynamic, so there are no outputs then.
+bool simulates_outputs(const ModelKernels& k) { return k.outputs_general || (k.outputs && !k.output_terms); }
 
 SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op, const SimulationOptions& o) {
   check_options(model, o);
@@ -364,31 +467,30 @@ SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op,
     throw SimulationError("simulate: the initial state fails " + at_time(0) + ": " + eq.reason(), 0.0);
   configure(cv, eq, o, message);
 
-  const auto samples = static_cast<Index>(std::ceil(o.duration / o.step * (1 - 1e-12))) + 1;
+  const Index samples = sample_count(o);
   SimulationResult r = allocated(k, samples);
   r.analytic_jacobian = eq.analytic_jacobian();
   record(r, 0, 0.0, cv, eq);
-  const std::vector<double> breaks = breakpoints(o);
-  auto next_break = breaks.begin();
+  const std::vector<Stop> stops = stop_times(o);
+  auto next = stops.begin();
   double t = 0;
   for (Index j = 1; j < samples; ++j) {
     double tout = j + 1 == samples ? o.duration : std::min(o.duration, static_cast<double>(j) * o.step);
-    // A sample within rounding of a breakpoint is taken at the breakpoint (the integrator
-    // restarts there and cannot start a step of a few ulps).
-    if (next_break != breaks.end() && std::abs(*next_break - tout) <= 1e-9 * o.step) tout = *next_break;
+    // A sample within rounding of a stop is taken at the stop (after a restart the integrator
+    // cannot start a step of a few ulps).
+    if (next != stops.end() && std::abs(next->t - tout) <= window(o, tout)) tout = next->t;
     while (t < tout) {
-      const bool at_break = next_break != breaks.end() && *next_break <= tout;
-      const double stop = at_break ? *next_break : o.duration;
-      CVodeSetStopTime(cv.mem, stop);
+      const double stop = next != stops.end() ? next->t : o.duration;
+      if (CVodeSetStopTime(cv.mem, stop) != CV_SUCCESS)
+        throw SimulationError("simulate: cannot stop at t = " + short_number(stop) + " s (internal error)", t);
       double reached = t;
       eq.failure = Equations::Failure::none;
       const int flag = CVode(cv.mem, std::min(tout, stop), cv.x, &reached, CV_NORMAL);
       if (flag < 0) integration_failed(flag, cv, eq, message);
       t = reached;
-      if (at_break && t >= stop) {  // restart after the jump: the history holds the old input
-        add_statistics(cv, r);
-        CVodeReInit(cv.mem, stop, cv.x);
-        ++r.restarts, ++next_break;
+      if (next != stops.end() && t >= next->t) {
+        if (next->restart) restart(cv, eq, r, next->t);
+        ++next;
       }
     }
     record(r, j, tout, cv, eq);

@@ -221,8 +221,11 @@ TEST(SolverCli, Simulate) {
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 5);  // t = 0, 0.25, 0.5, 0.75, 1
   ASSERT_EQ(solve({"simulate", "--duration", "0.5", "--step", "0.5", "--format", "json", "--method", "adams"}, &out, &err), 0);
-  EXPECT_EQ(out.rfind("{\"model\":\"double_pendulum\",\"scene\":\"full\",\"method\":\"adams\",\"jacobian\":\"none\"", 0), 0u) << out;
-  EXPECT_NE(out.find("\"t\":[0,0.5],\"series\":{\"phi1\":[0,0]"), std::string::npos) << out;
+  EXPECT_EQ(out.rfind("{\"model\":\"double_pendulum\",\"scene\":\"full\",\"method\":\"adams\",\"jacobian\":\"none\","
+                      "\"restarts\":0,\"t\":[0,0.5],\"series\":{\"phi1\":[0,0]", 0), 0u) << out;
+  ASSERT_EQ(solve({"simulate", "--duration", "0.5", "--step", "0.5", "--format", "json", "--statistics"}, &out, &err), 0);
+  EXPECT_NE(out.find(",\"statistics\":{\"steps\":"), std::string::npos) << out;
+  EXPECT_EQ(err.rfind("simulate: 2 samples, bdf, ", 0), 0u) << err;
   TempDir dir;
   const std::string plot = (dir.path / "motion.svg").string();
   ASSERT_EQ(solve({"simulate", "--duration", "1", "--initial", "phi1=0.5", "--plot", plot, "--show", "phi1", "--show",

@@ -54,13 +54,17 @@ class InputSignal {
   static InputSignal table(std::vector<double> times, std::vector<double> values);
   /// Parses the command line's form (docs/cli.md, `simulate --input`): VALUE, `sine:AMPLITUDE,HZ
   /// [,PHASE_DEG[,OFFSET]]`, `step:AMPLITUDE[,TIME[,BEFORE]]`, `chirp:AMPLITUDE,F0_HZ,F1_HZ[,
-  /// DURATION]` (default: `duration`), `table:FILE` (a CSV file of t,value lines; a first line that
-  /// is not numbers is a header). NameError with the reason for anything else.
+  /// DURATION]` (default: `duration`), `table:FILE` (a CSV file of t,value lines; lines starting
+  /// with # are comments, and a first line whose first field does not start like a number is a
+  /// header). NameError with the reason for anything else.
   static InputSignal parse(const std::string& spec, double duration);
 
   double operator()(double t) const;
   /// Times where the signal jumps (a step): the integrator restarts there.
   const std::vector<double>& breakpoints() const { return breakpoints_; }
+  /// Times where its slope jumps (a table's points): the integrator stops there, so that it
+  /// cannot step over a short feature of the table.
+  const std::vector<double>& knots() const { return t_; }
 
  private:
   enum class Kind { constant, sine, step, chirp, table } kind_ = Kind::constant;
@@ -90,11 +94,15 @@ struct SimulationResult {
   Eigen::VectorXd t;      ///< sample times, s
   Eigen::MatrixXd y, yd;  ///< n_coordinates × samples
   Eigen::MatrixXd u;      ///< n_inputs × samples
-  Eigen::MatrixXd z;      ///< n_outputs × samples (empty when the kernels give no outputs)
+  Eigen::MatrixXd z;      ///< n_outputs × samples (0 × samples when !simulates_outputs())
   bool analytic_jacobian = false;  ///< BDF's Newton matrices from `dynamics_jacobian`
   long steps = 0, rhs_evaluations = 0, jacobian_evaluations = 0, error_test_failures = 0,
        nonlinear_failures = 0, restarts = 0;
 };
+
+/// Whether simulate() gives the outputs of kernels k (SimulationResult::z): they need
+/// `outputs_general`, or `outputs` when no output depends on ÿ or u.
+bool simulates_outputs(const ModelKernels& k);
 
 /// Integrates the model from the operating point `op` (with options.initial applied) over
 /// [0, duration]. Throws NameError for an unknown initial name, DimensionError for a wrong number
