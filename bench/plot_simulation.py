@@ -32,6 +32,8 @@ def read(path):
 
 
 def tone_slopes(results, images, work):
+    if not os.path.exists(os.path.join(results, "tone_slopes.csv")):
+        return
     rows = read(os.path.join(results, "tone_slopes.csv"))
     groups = {}
     for r in rows:
@@ -56,6 +58,8 @@ plot """ + ", ".join(plots) + ", 1e-5*x dt 2 lc rgb 'gray' title 'slope 1', 1e-2
 
 
 def middle_ear_spl(results, images, work):
+    if not os.path.exists(os.path.join(results, "middle_ear_spl.csv")):
+        return
     rows = read(os.path.join(results, "middle_ear_spl.csv"))
     by_hz = {}
     for r in rows:

@@ -17,6 +17,7 @@ import sys
 
 from report_engines import engines_section  # issue 17 §2: MuJoCo and KDL (bench/engines.sh)
 from report_scale import section as scale_section  # issue 17 §1: large models (bench/compile_scale.py)
+from report_simulation import simulation_section  # issue 18 §4: simulate() against SciPy
 
 RESULTS, OUTPUT, IMAGES = sys.argv[1], sys.argv[2], sys.argv[3]
 F_REPORT = 100  # frequencies per sweep in frf_accuracy (kF)
@@ -827,6 +828,8 @@ w("")
 w("`auto` is the cheapest acceptable method, or within 1.5× of it, in %d of %d cases; the others are "
   "listed with the reason." % (agree, total))
 w("")
+
+out.extend(simulation_section(RESULTS, table))
 
 with open(OUTPUT, "w") as f:
     f.write("\n".join(out) + "\n")

@@ -23,12 +23,12 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-PROBLEMS = {  # id, duration, step, initial coordinates, input (amplitude, Hz), atol scale
-    "pendulum": ("simple_pendulum", 10.0, 0.01, {0: 2.5}, None, 1.0),
-    "double_pendulum": ("double_pendulum", 100.0, 0.1, {0: 1.0}, None, 1.0),
-    "middle_ear": ("middle_ear", 0.02, 1e-5, {}, (1.0, 1000.0), 1e-9),
+PROBLEMS = {  # id, duration, step, initial coordinates, input (amplitude, Hz), atol scale, tolerances
+    "pendulum": ("simple_pendulum", 10.0, 0.01, {0: 2.5}, None, 1.0, (1e-4, 1e-6, 1e-8, 1e-10)),
+    "double_pendulum": ("double_pendulum", 100.0, 0.1, {0: 0.5}, None, 1.0, (1e-4, 1e-6, 1e-8, 1e-10)),
+    # rtol 1e-10 is at the kernels' rounding floor (ours takes 190,000 steps; Radau tens of minutes)
+    "middle_ear": ("middle_ear", 0.02, 1e-5, {}, (1.0, 1000.0), 1e-9, (1e-4, 1e-6, 1e-8)),
 }
-RTOLS = (1e-4, 1e-6, 1e-8, 1e-10)
 
 
 def load(generated, model_id, work):
@@ -105,7 +105,7 @@ def main():
             out.append((r["problem"], "mbsgen " + r["method"].upper().replace("ADAMS", "Adams"), float(r["rtol"]),
                         float(r["seconds"]), error(y, ref)))
     work = tempfile.mkdtemp(prefix="mbsgen-scipy-")
-    for name, (model_id, duration, step, initial, tone, atol_scale) in PROBLEMS.items():
+    for name, (model_id, duration, step, initial, tone, atol_scale, rtols) in PROBLEMS.items():
         p, n, m = parameters(generated, model_id)
         model = Model(load(generated, model_id, work), model_id, n, m, p)
         t_ref, ref = read_samples(os.path.join(results, "reference_%s.csv" % name))
@@ -123,7 +123,7 @@ def main():
             return model.jac(x[:n], x[n:], u_of(t))
 
         for method in ("Radau", "LSODA"):
-            for rtol in RTOLS:
+            for rtol in rtols:
                 seconds, sol = [], None
                 for _ in range(repeats):
                     t0 = time.perf_counter()

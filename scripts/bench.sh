@@ -36,7 +36,7 @@ log() { printf '[bench %4ds] %s\n' $(( $(date +%s) - start )) "$*" >&2; }
 
 # ---- dependencies -------------------------------------------------------------------------------
 scripts/deps.sh
-extra=(python3-sympy octave octave-control libbenchmark-dev gnuplot-nox libmujoco-dev liborocos-kdl-dev)
+extra=(python3-sympy python3-scipy octave octave-control libbenchmark-dev gnuplot-nox libmujoco-dev liborocos-kdl-dev)
 missing=()
 for p in "${extra[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -59,7 +59,8 @@ out=${out:-$build/results}
 log "configuring $build (Release, benchmarks on, tests off)"
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DMBSGEN_BUILD_BENCH=ON -DMBSGEN_BUILD_TESTS=OFF >/dev/null
 log "building frf_accuracy modes_accuracy generation_cost (-j $jobs)"
-cmake --build "$build" --target frf_accuracy modes_accuracy generation_cost kernel_call_timing mbsgen -j "$jobs" >/dev/null
+cmake --build "$build" --target frf_accuracy modes_accuracy generation_cost kernel_call_timing mbsgen nonlinear_tones \
+  simulation_timing -j "$jobs" >/dev/null
 rm -rf "$out"
 mkdir -p "$out"
 
@@ -146,6 +147,14 @@ for d in "$out"/modes_data/*/; do
     echo "octave,$name,,,timeout,nan,nan" >>"$out/octave_modes.csv"
 done
 bench/engines.sh --build "$build" --out "$out" --jobs "$jobs" "${q[@]}" || log "engines: failed (see $out/engines.log)"
+# Time simulation (issue 18 §2–4): tones against the frequency response and the middle ear's growth
+# with the level (about 7 min), simulate() timed (about 1 min), SciPy's solve_ivp through the same
+# kernels (about 15 min).
+log "simulation: nonlinear_tones, simulation_timing, simulation_compare.py (SciPy)"
+"$build/bench/nonlinear_tones" "$out" >"$out/nonlinear_tones.log" 2>&1 || log "nonlinear_tones: failed"
+"$build/bench/simulation_timing" "$out" 5 >"$out/simulation_timing.log" 2>&1 || log "simulation_timing: failed"
+"$python" bench/simulation_compare.py "$build/generated/mbsgen" "$out" 3 >"$out/simulation_compare.log" 2>&1 ||
+  log "simulation_compare: failed (see $out/simulation_compare.log)"
 echo "load_end: $(cut -d' ' -f1-3 /proc/loadavg)" >>"$out/system.txt"
 echo "duration_s: $(( $(date +%s) - start ))" >>"$out/system.txt"
 
@@ -153,7 +162,9 @@ echo "duration_s: $(( $(date +%s) - start ))" >>"$out/system.txt"
 if [ $doc -eq 1 ]; then
   log "writing docs/accuracy-vs-time.md and docs/accuracy-vs-time/"
   "$python" bench/report.py "$out" docs/accuracy-vs-time.md docs/accuracy-vs-time
+  "$python" bench/plot_simulation.py "$out" docs/simulation
 else
+  "$python" bench/plot_simulation.py "$out" "$out/simulation"
   "$python" bench/report.py "$out" "$out/accuracy-vs-time.md" "$out/accuracy-vs-time"
 fi
 log "done"

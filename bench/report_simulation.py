@@ -1,0 +1,80 @@
+"""Section "Time simulation" of docs/accuracy-vs-time.md (issue 18 §4), from
+RESULTS/simulation_compare.csv (bench/simulation_timing and bench/simulation_compare.py); the
+work-precision plots are bench/plot_simulation.py's, in docs/simulation/.
+
+    simulation_section(results, table) -> list of markdown lines (empty without the CSV)
+
+Run alone, `python3 bench/report_simulation.py RESULTS` prints the section.
+"""
+import csv
+import math
+import os
+import sys
+
+LABELS = {"pendulum": "simple pendulum from 2.5 rad, 10 s",
+          "double_pendulum": "double pendulum from 0.5 rad, 100 s",
+          "middle_ear": "middle ear, 1 Pa at 1 kHz, 20 ms"}
+
+
+def _rows(results):
+    path = os.path.join(results, "simulation_compare.csv")
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return [dict(r, rtol=float(r["rtol"]), seconds=float(r["seconds"]), error=float(r["error"] or "nan"))
+                for r in csv.DictReader(f)]
+
+
+def _equal_accuracy(rows, problem):
+    """For each SciPy run: our fastest run at least as accurate, and the ratio of the times."""
+    ours = [r for r in rows if r["problem"] == problem and r["solver"].startswith("mbsgen")]
+    out = []
+    for s in rows:
+        if s["problem"] != problem or not s["solver"].startswith("SciPy") or not math.isfinite(s["error"]):
+            continue
+        better = [o for o in ours if math.isfinite(o["error"]) and o["error"] <= s["error"]]
+        if better:
+            best = min(better, key=lambda o: o["seconds"])
+            out.append((s, best, s["seconds"] / best["seconds"]))
+    return out
+
+
+def simulation_section(results, table):
+    rows = _rows(results)
+    if not rows:
+        return []
+    out = ["## 6. Time simulation", "",
+           "`simulate` (SUNDIALS CVODE, docs/simulation.md) against SciPy's `solve_ivp` (Radau and LSODA, "
+           "Debian python3-scipy) on the same problems, in the same run. SciPy's right-hand side and Jacobian "
+           "call the same generated kernels (a shared library through ctypes; M ÿ = −(k − q) by "
+           "`numpy.linalg.solve`), so the difference is the integrators and the language around them. Error: "
+           "the largest difference of a coordinate from a reference run (ours at rtol 1e-13; the middle ear's "
+           "1e-11), relative to the largest coordinate, over all samples; atol = rtol (the middle ear: "
+           "rtol × 1e-9 m). Times are medians (ours of 5 runs, SciPy's of 3). `bench/simulation_timing`, "
+           "`bench/simulation_compare.py`.", ""]
+    for problem in [p for p in LABELS if any(r["problem"] == p for r in rows)]:
+        out.append("**%s**" % LABELS[problem])
+        out.append("")
+        body = []
+        for r in sorted((r for r in rows if r["problem"] == problem), key=lambda r: (r["solver"], -r["rtol"])):
+            body.append([r["solver"], "%g" % r["rtol"], "%.3g s" % r["seconds"],
+                         "%.2e" % r["error"] if math.isfinite(r["error"]) else "failed"])
+        out.append(table(["solver", "rtol", "time", "error"], body))
+        out.append("")
+        eq = _equal_accuracy(rows, problem)
+        if eq:
+            ratios = [x[2] for x in eq]
+            out.append("At equal or better accuracy, ours is %.0f–%.0f× faster than SciPy (each SciPy run against our "
+                       "fastest run at least as accurate; median %.0f×)." %
+                       (min(ratios), max(ratios), sorted(ratios)[len(ratios) // 2]))
+            out.append("")
+        out.append("![work_precision_%s](simulation/work_precision_%s.svg)" % (problem, problem))
+        out.append("")
+    return out
+
+
+if __name__ == "__main__":
+    def _table(header, body):
+        lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        return "\n".join(lines + ["| " + " | ".join(r) + " |" for r in body])
+    print("\n".join(simulation_section(sys.argv[1], _table)))
