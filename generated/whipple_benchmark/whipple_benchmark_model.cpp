@@ -25,7 +25,9 @@ const mbsgen::ModelKernels& kernels() {
       whipple_benchmark_input_names, input_units, whipple_benchmark_output_names, output_units,
       &whipple_benchmark_operating_point, nullptr, nullptr, nullptr,
       0, false, "0.1.0", nullptr, &whipple_benchmark_outputs,
-      3, whipple_benchmark_speed_names, &whipple_benchmark_descriptor, 2, whipple_benchmark_reduced_coordinate_names, &whipple_benchmark_reduced, 4, whipple_benchmark_reduced_part_names, &whipple_benchmark_reduced_parts};
+      3, whipple_benchmark_speed_names, &whipple_benchmark_descriptor, 2, whipple_benchmark_reduced_coordinate_names, &whipple_benchmark_reduced, 4, whipple_benchmark_reduced_part_names, &whipple_benchmark_reduced_parts,
+      nullptr, nullptr, nullptr,
+      whipple_benchmark_n_tree_coordinates, whipple_benchmark_n_constraints, &whipple_benchmark_assemble, &whipple_benchmark_constraints};
   return k;
 }
 

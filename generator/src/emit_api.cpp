@@ -154,11 +154,15 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     c << ",\n      " << lin.speeds.size() << ", " << id << "_speed_names, " << kernel("descriptor") << ", "
       << lin.reduced.coordinates.size() << ", " << id << "_reduced_coordinate_names, " << kernel("reduced") << ", "
       << lin.reduced.named.size() << ", " << id << "_reduced_part_names, " << kernel("reduced_parts");
-  // Time integration (EmitOptions::dynamics) and the outputs at any state.
-  if (has_kernel(code, "dynamics") || has_kernel(code, "outputs_general")) {
+  // Time integration (EmitOptions::dynamics), the outputs at any state, and closed loops.
+  const bool loops = has_kernel(code, "assemble");
+  if (has_kernel(code, "dynamics") || has_kernel(code, "outputs_general") || loops) {
     if (!lin.descriptor) c << ",\n      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr";
     c << ",\n      " << kernel("dynamics") << ", " << kernel("dynamics_jacobian") << ", " << kernel("outputs_general");
   }
+  if (loops)
+    c << ",\n      " << id << "_n_tree_coordinates, " << id << "_n_constraints, " << kernel("assemble") << ", "
+      << kernel("constraints");
   c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"

@@ -90,6 +90,7 @@ void write_json(std::ostream& out, const ModelKernels& k, const SimulateOptions&
       << ",\"method\":" << json_string(o.method) << ",\"jacobian\":"
       << json_string(o.method == "adams" ? "none" : r.analytic_jacobian ? "kernels" : "difference quotients")
       << ",\"restarts\":" << r.restarts;
+  if (k.n_constraints > 0) out << ",\"constraint_drift\":" << num(r.constraint_drift, true);
   if (o.statistics)  // counts that vary with the SUNDIALS version and the libm: asked for only
     out << ",\"statistics\":{\"steps\":" << r.steps << ",\"rhs_evaluations\":" << r.rhs_evaluations
         << ",\"jacobian_evaluations\":" << r.jacobian_evaluations << ",\"error_test_failures\":" << r.error_test_failures
@@ -150,7 +151,9 @@ void print_statistics(std::ostream& err, const SimulateOptions& o, const Simulat
     err << ", " << r.jacobian_evaluations << " Jacobians (" << (r.analytic_jacobian ? "kernels" : "difference quotients")
         << ")";
   err << ", " << r.error_test_failures << " error test failures, " << r.nonlinear_failures
-      << " corrector failures, " << r.restarts << " restarts\n";
+      << " corrector failures, " << r.restarts << " restarts";
+  if (r.constraint_drift > 0) err << ", largest |Phi| " << short_num(r.constraint_drift);
+  err << "\n";
 }
 
 }  // namespace

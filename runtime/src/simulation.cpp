@@ -369,8 +369,14 @@ void record(SimulationResult& r, Index j, double t, Cvode& cv, Equations& eq) {
   if (!r.y.col(j).allFinite() || !r.yd.col(j).allFinite())
     throw SimulationError("simulate: the state is not finite " + at_time(t), t);
   r.u.col(j) = eq.inputs_at(t);
-  if (r.z.rows() == 0) return;
   const std::vector<double>& p = eq.parameters();
+  if (k.assemble && k.constraints && k.n_constraints > 0) {  // closed loops: Φ at the sample
+    std::vector<double> tree(static_cast<std::size_t>(k.n_tree_coordinates)), phi(static_cast<std::size_t>(k.n_constraints));
+    if (k.assemble(x, p.data(), tree.data()) != 0 || k.constraints(tree.data(), p.data(), phi.data()) != 0)
+      throw SimulationError("simulate: the kinematic loops could not be closed " + at_time(t), t);
+    for (double v : phi) r.constraint_drift = std::max(r.constraint_drift, std::abs(v));
+  }
+  if (r.z.rows() == 0) return;
   int status = 0;
   if (k.outputs_general) {
     if (!eq.evaluate(t, x, x + n)) throw SimulationError("simulate: " + eq.reason() + " " + at_time(t), t);

@@ -92,6 +92,12 @@ struct ModelKernels {
   /// `outputs` gives them). Trailing.
   int (*outputs_general)(const double* y, const double* yd, const double* ydd, const double* u,
                          const double* p, double* z) = nullptr;
+  /// Closed loops (issue 15; null, 0: none): the tree's coordinates y (n_tree_coordinates) from the
+  /// independent ones, and the constraints Φ(y) (n_constraints), for the drift a simulation
+  /// reports. Trailing.
+  int n_tree_coordinates = 0, n_constraints = 0;
+  int (*assemble)(const double* yi, const double* p, double* y) = nullptr;
+  int (*constraints)(const double* y, const double* p, double* phi) = nullptr;
 };
 
 /// The first n entries of a kernel name array (null entries become "").

@@ -96,6 +96,11 @@ struct SimulationResult {
   Eigen::MatrixXd u;      ///< n_inputs × samples
   Eigen::MatrixXd z;      ///< n_outputs × samples (0 × samples when !simulates_outputs())
   bool analytic_jacobian = false;  ///< BDF's Newton matrices from `dynamics_jacobian`
+  /// Closed loops: the largest |Φ| over the samples, in the constraints' units (metres for a
+  /// pin). The kernels close the loops by Newton's method at every evaluation (coordinate
+  /// partitioning: the state holds the independent coordinates), so this is the closure's own
+  /// residual; 0 for a model without loops.
+  double constraint_drift = 0;
   long steps = 0, rhs_evaluations = 0, jacobian_evaluations = 0, error_test_failures = 0,
        nonlinear_failures = 0, restarts = 0;
 };
