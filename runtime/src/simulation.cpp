@@ -334,6 +334,8 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   if (theirs && eq.failure != Equations::Failure::none) {
     t = eq.failed_time;
     why = eq.reason();
+  } else if (eq.failure != Equations::Failure::none) {  // a likely cause: say so, as such
+    why += "; the last evaluation that failed on the way, at t = " + short_number(eq.failed_time) + " s: " + eq.reason();
   }
   throw SimulationError("simulate: the integration stopped " + at_time(t) + ": " + why +
                             (message.empty() ? "" : " [CVODE: " + message + "]"),
