@@ -14,16 +14,7 @@ namespace {
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 
 double number_in(const std::string& text, const std::string& spec) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(v))
-    throw NameError("input signal '" + spec + "': '" + text + "' is not a finite number");
-  return v;
+  return finite_number(text, "input signal '" + spec + "'");
 }
 
 std::vector<double> numbers_in(const std::string& list, const std::string& spec) {
@@ -74,6 +65,19 @@ InputSignal table_from_file(const std::string& path, const std::string& spec) {
 }
 
 }  // namespace
+
+double finite_number(const std::string& text, const std::string& what) {
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(v))
+    throw NameError(what + ": '" + text + "' is not a finite number");
+  return v;
+}
 
 InputSignal InputSignal::constant(double value) {
   InputSignal s;

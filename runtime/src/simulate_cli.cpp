@@ -33,16 +33,7 @@ SimulationOptions simulation_options(const GeneratedModel& model, const Simulate
   s.method = o.method == "adams" ? IntegrationMethod::adams : IntegrationMethod::bdf;
   for (const std::string& a : o.initial) {
     const auto [name, text] = assignment(a, "--initial");
-    std::size_t used = 0;
-    double v = NAN;
-    try {
-      v = std::stod(text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != text.size() || !std::isfinite(v))
-      throw NameError("--initial '" + a + "': '" + text + "' is not a finite number");
-    s.initial.emplace_back(name, v);
+    s.initial.emplace_back(name, finite_number(text, "--initial '" + a + "'"));
   }
   if (!o.inputs.empty()) s.inputs.resize(static_cast<std::size_t>(model.kernels().n_inputs));
   for (const std::string& a : o.inputs) {

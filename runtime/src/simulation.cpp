@@ -106,10 +106,7 @@ class Equations {
   // The inputs at t; at the start of a segment (t = 0, or a breakpoint where the integrator
   // restarted) their value just after it, so that a step at the start acts from the start.
   const VectorXd& inputs(double t) {
-    const double at = t <= segment_start_ ? std::nextafter(segment_start_, kInfinity) : t;
-    for (Index i = 0; i < u_.size(); ++i)
-      u_[i] = options_.inputs.empty() ? 0.0 : options_.inputs[static_cast<std::size_t>(i)](at);
-    return u_;
+    return inputs_at(t <= segment_start_ ? std::nextafter(segment_start_, kInfinity) : t);
   }
   const VectorXd& inputs_at(double t) {  // the signals' own values (left-continuous at a step)
     for (Index i = 0; i < u_.size(); ++i)

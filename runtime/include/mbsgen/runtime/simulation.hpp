@@ -36,6 +36,10 @@ class SimulationError : public Error {
   double time_;
 };
 
+/// `text` as a finite double, all of it; NameError "WHAT: 'TEXT' is not a finite number" otherwise
+/// (the command line's values of `--input` and `--initial`).
+double finite_number(const std::string& text, const std::string& what);
+
 /// An input as a function of time.
 class InputSignal {
  public:
