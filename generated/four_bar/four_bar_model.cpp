@@ -27,7 +27,8 @@ const mbsgen::ModelKernels& kernels() {
       0, false, "0.1.0", &four_bar_output_terms, &four_bar_outputs,
       0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
       &four_bar_dynamics, nullptr, &four_bar_outputs_general,
-      four_bar_n_tree_coordinates, four_bar_n_constraints, &four_bar_assemble, &four_bar_constraints};
+      four_bar_n_tree_coordinates, four_bar_n_constraints, &four_bar_assemble, &four_bar_constraints,
+      &four_bar_assemble_from, &four_bar_dynamics_full, &four_bar_outputs_full, &four_bar_outputs_general_full};
   return k;
 }
 

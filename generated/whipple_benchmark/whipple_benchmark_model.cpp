@@ -27,7 +27,8 @@ const mbsgen::ModelKernels& kernels() {
       0, false, "0.1.0", nullptr, &whipple_benchmark_outputs,
       3, whipple_benchmark_speed_names, &whipple_benchmark_descriptor, 2, whipple_benchmark_reduced_coordinate_names, &whipple_benchmark_reduced, 4, whipple_benchmark_reduced_part_names, &whipple_benchmark_reduced_parts,
       nullptr, nullptr, nullptr,
-      whipple_benchmark_n_tree_coordinates, whipple_benchmark_n_constraints, &whipple_benchmark_assemble, &whipple_benchmark_constraints};
+      whipple_benchmark_n_tree_coordinates, whipple_benchmark_n_constraints, &whipple_benchmark_assemble, &whipple_benchmark_constraints,
+      &whipple_benchmark_assemble_from, nullptr, &whipple_benchmark_outputs_full, nullptr};
   return k;
 }
 

@@ -246,6 +246,9 @@ struct Kernel {
   /// tree's coordinates, and `<name>` takes the independent ones and closes the loops first
   /// (loop_kernels below).
   bool wrapped = false;
+  /// A wrapped kernel whose `<name>_full` is public too (declared in the header): a simulation
+  /// keeps the tree's coordinates itself and closes the loops from the last ones (assemble_from).
+  bool full_public = false;
   /// Emitted as a static function (not declared in the header).
   bool internal = false;
   /// Code that computes the outputs instead of their expressions (whose values are then only
@@ -447,7 +450,7 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
 
   std::ostringstream code;
   code << "// " << k.doc << "\n// operations: " << operations << "\n";
-  code << (k.wrapped || k.internal ? "static " : "extern \"C\" ") << sig << " {\n";
+  code << ((k.wrapped && !k.full_public) || k.internal ? "static " : "extern \"C\" ") << sig << " {\n";
   for (const auto& a : k.inputs) code << "  (void)" << a.name << ";\n";
   code << body << zeros_at_operating_point(k);
   code << "  int status = 0;\n";
@@ -563,9 +566,11 @@ std::vector<Kernel> loop_kernels(Equations& eq, const LinearEquations& lin) {
   return k;
 }
 
-// `assemble`: the tree's coordinates from the independent ones, the dependent ones by Newton's
-// method on Φ(y) = 0 from the operating point. Status 2 when it fails (a singular Jacobian or
-// no convergence in 50 steps): the loops cannot be closed there.
+// `assemble_from`: the tree's coordinates from the independent ones, the dependent ones by
+// Newton's method on Φ(y) = 0 from the values y holds on entry (a simulation's last closed
+// configuration, so that it follows the motion through any range). Status 2 when it fails (a
+// singular Jacobian or no convergence in 50 steps): the loops cannot be closed there. `assemble`
+// starts it from the operating point.
 std::string assemble_code(const std::string& id, const Equations& eq) {
   const LoopClosure& loops = eq.loops;
   const std::size_t n = eq.y.size(), m = loops.equations.size(), f = loops.independent.size();
@@ -578,16 +583,17 @@ std::string assemble_code(const std::string& id, const Equations& eq) {
   for (std::size_t k = 0; k < m; ++k) scales += (k ? ", " : "") + format_double(loops.equations[k].scale > 0 ? loops.equations[k].scale : 1.0);
   std::ostringstream c;
   c << "// Closes the loops: y (" << n << " tree coordinates) from yi (the " << f
-    << " independent ones); the dependent\n// ones by Newton's method on Phi(y) = 0, starting from the "
-       "operating point. Returns 0, 1 (not finite)\n// or 2 (the loops cannot be closed there: a singular "
-       "Jacobian, or no convergence).\n";
-  c << "extern \"C\" int " << id << "_assemble(const double* yi, const double* p, double* y) {\n";
+    << " independent ones); the dependent\n// ones by Newton's method on Phi(y) = 0, starting from "
+       "their values in y on entry (a nearby\n// closed configuration: Newton finds the closest solution). "
+       "Returns 0, 1 (not finite) or 2 (the\n// loops cannot be closed there: a singular Jacobian, or no "
+       "convergence).\n";
+  c << "extern \"C\" int " << id << "_assemble_from(const double* yi, const double* p, double* y) {\n";
   c << "  static const int independent[" << f << "] = {" << list(loops.independent) << "};\n";
   c << "  static const int dependent[" << m << "] = {" << list(loops.dependent) << "};\n";
   c << "  static const double scale[" << m << "] = {" << scales << "};\n";
-  c << "  double yd0[" << n << "], phi[" << m << "], J[" << m * n << "], A[" << m * m << "], dx[" << m << "];\n";
-  c << "  if (" << id << "_operating_point_full(p, y, yd0) != 0) return 1;\n";
+  c << "  double phi[" << m << "], J[" << m * n << "], A[" << m * m << "], dx[" << m << "];\n";
   c << "  for (int i = 0; i < " << f << "; ++i) y[independent[i]] = yi[i];\n";
+  c << "  if (!all_finite(y, " << n << ")) return 1;\n";
   c << "  for (int iteration = 0; iteration < 50; ++iteration) {\n";
   c << "    if (" << id << "_constraints(y, p, phi) != 0 || " << id << "_constraint_jacobian(y, p, J) != 0) return 1;\n";
   c << "    // Near the solution the residual is rounding (about 1e-16 of each equation's size); one\n"
@@ -600,6 +606,11 @@ std::string assemble_code(const std::string& id, const Equations& eq) {
   c << "    for (int b = 0; b < " << m << "; ++b) y[dependent[b]] -= dx[b];\n";
   c << "    if (!all_finite(y, " << n << ")) return 1;\n";
   c << "    if (small) return 0;\n  }\n  return 2;\n}\n\n";
+  c << "// Closes the loops as " << id << "_assemble_from, starting from the operating point.\n";
+  c << "extern \"C\" int " << id << "_assemble(const double* yi, const double* p, double* y) {\n";
+  c << "  double yd0[" << n << "];\n";
+  c << "  if (" << id << "_operating_point_full(p, y, yd0) != 0) return 1;\n";
+  c << "  return " << id << "_assemble_from(yi, p, y);\n}\n\n";
   return c.str();
 }
 
@@ -1101,7 +1112,10 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
   kernels.push_back(bodies_kernel(eq, nb, y, p, f));
 
   if (loops)
-    for (auto& k : kernels) k.wrapped = k.name != "operating_point";
+    for (auto& k : kernels) {
+      k.wrapped = k.name != "operating_point";
+      k.full_public = k.name == "dynamics" || k.name == "outputs" || k.name == "outputs_general";
+    }
   return kernels;
 }
 
@@ -1242,6 +1256,7 @@ std::uint64_t fingerprint(const Kernel& k, const Program& prog) {
   const std::hash<std::string> text;
   std::uint64_t h = mix(text(k.name), text(k.doc));
   h = mix(mix(h, k.wrapped), mix(k.internal, text(k.computed_by)));
+  h = mix(h, k.full_public);
   h = mix(h, k.computed_by_operations);
   for (const auto& a : k.inputs) {
     h = mix(h, text(a.name));
@@ -1386,6 +1401,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
       if (!k.internal) out.kernels.push_back(ek.info);
     }
     kernel_code << assemble_code(out.id, eq);
+    out.kernels.push_back({"assemble_from", "int " + out.id + "_assemble_from(const double* yi, const double* p, double* y)", 0});
     out.kernels.push_back({"assemble", "int " + out.id + "_assemble(const double* yi, const double* p, double* y)", 0});
   }
   bool split_needed = false;
@@ -1408,12 +1424,17 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
         chunks.push_back({ek.chunks.definitions[c], ek.chunks.operations[c]});
     }
     kernel_code << ek.code;
+    KernelInfo full_info = ek.info;
     if (k.wrapped) {
       const std::string full = "_" + k.name + "_full(";
       ek.info.signature.replace(ek.info.signature.find(full), full.size(), "_" + k.name + "(");
       kernel_code << wrapper_code(out.id, k, ek.info.signature, n);
     }
     out.kernels.push_back(ek.info);
+    if (k.full_public) {
+      full_info.name += "_full";
+      out.kernels.push_back(full_info);
+    }
   }
   // A child whose result was not asked for (other options) is stopped and reaped now, before a
   // caller's own waitpid could take it.

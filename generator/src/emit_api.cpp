@@ -162,7 +162,8 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
   }
   if (loops)
     c << ",\n      " << id << "_n_tree_coordinates, " << id << "_n_constraints, " << kernel("assemble") << ", "
-      << kernel("constraints");
+      << kernel("constraints") << ",\n      " << kernel("assemble_from") << ", " << kernel("dynamics_full") << ", "
+      << kernel("outputs_full") << ", " << kernel("outputs_general_full");
   c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"

@@ -97,6 +97,45 @@ class Equations {
       : k_(model.kernels()), p_(model.parameters()), n_(k_.n_coordinates), options_(o),
         M_(n_, n_), r_(n_), u_(k_.n_inputs), a_(n_), Ky_(n_, n_), Kv_(n_, n_) {}
 
+  // Closed loops, followed through any range: the tree's coordinates at the last accepted step
+  // (`anchor_`), from which every evaluation closes the loops again (assemble_from).
+  bool follows_loops() const {
+    return k_.n_constraints > 0 && k_.assemble && k_.assemble_from && k_.dynamics_full && k_.constraints &&
+           (k_.n_outputs == 0 || (k_.outputs_general ? k_.outputs_general_full != nullptr : k_.outputs_full != nullptr));
+  }
+  // The initial closed configuration: from the operating point's (yi0) to yi's by continuation
+  // in the independent coordinates (32 steps, halved where Newton fails), so that the loops close
+  // on the operating point's branch. False when they cannot be closed.
+  bool close_initial(const VectorXd& yi0, const VectorXd& yi) {
+    anchor_.assign(static_cast<std::size_t>(k_.n_tree_coordinates), 0.0);
+    if (k_.assemble(yi0.data(), p_.data(), anchor_.data()) != 0) return false;
+    double done = 0, step = 1.0 / 32;
+    std::vector<double> trial;
+    while (done < 1) {
+      const double to = std::min(1.0, done + step);
+      const VectorXd at = yi0 + to * (yi - yi0);
+      trial = anchor_;
+      if (k_.assemble_from(at.data(), p_.data(), trial.data()) == 0) {
+        anchor_.swap(trial);
+        done = to;
+      } else if ((step /= 2) < 1.0 / 4096) {
+        return false;
+      }
+    }
+    return true;
+  }
+  // After an accepted step to y: the loops closed there become the start of the next ones.
+  void advance(const double* y) {
+    std::vector<double>& trial = tree_;
+    trial = anchor_;
+    if (k_.assemble_from(y, p_.data(), trial.data()) == 0) anchor_.swap(trial);
+  }
+  // The closed configuration at y (independent coordinates), from the anchor; null on failure.
+  const double* closed(const double* y) {
+    tree_ = anchor_;
+    return k_.assemble_from(y, p_.data(), tree_.data()) == 0 ? tree_.data() : nullptr;
+  }
+
   Index size() const { return n_; }
   const ModelKernels& kernels() const { return k_; }
   bool analytic_jacobian() const {
@@ -119,7 +158,10 @@ class Equations {
   bool evaluate(double t, const double* y, const double* yd) {
     inputs(t);
     int s = 0;
-    if (k_.dynamics) {
+    if (follows_loops()) {
+      const double* tree = closed(y);
+      s = tree ? k_.dynamics_full(tree, yd, u_.data(), p_.data(), M_.data(), r_.data()) : 2;
+    } else if (k_.dynamics) {
       s = k_.dynamics(y, yd, u_.data(), p_.data(), M_.data(), r_.data());
     } else {
       s = k_.mass_matrix(y, p_.data(), M_.data());
@@ -194,6 +236,7 @@ class Equations {
   MatrixXd M_;
   VectorXd r_, u_, a_;
   MatrixXd Ky_, Kv_;
+  std::vector<double> anchor_, tree_;
   Eigen::PartialPivLU<MatrixXd> lu_;
   double rcond_ = 0, segment_start_ = 0;
 };
@@ -291,9 +334,12 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
 }
 
 // The reason a CVode flag gives, and the time.
-[[noreturn]] void integration_failed(int flag, Cvode& cv, const Equations& eq, const std::string& message) {
+// `reached`: the last time the integrator stood at (a lost step control can leave CVODE's own
+// time, or the time of a failed evaluation, not finite).
+[[noreturn]] void integration_failed(int flag, Cvode& cv, const Equations& eq, const std::string& message, double reached) {
   double t = 0;
   CVodeGetCurrentTime(cv.mem, &t);
+  if (!std::isfinite(t)) t = reached;
   std::string why;
   switch (flag) {
     case CV_TOO_MUCH_WORK:
@@ -316,7 +362,7 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
       CVodeGetCurrentStep(cv.mem, &next);
       const double h = last != 0 ? last : next;
       const bool stuck = h != 0 && std::abs(h) <= 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t));
-      const bool lost = flag == CV_BAD_T || flag == CV_ILL_INPUT;  // from its own interpolation
+      const bool lost = flag == CV_BAD_T || flag == CV_ILL_INPUT;  // from its interpolation, or a time not finite
       why = stuck ? "the integrator cannot advance (step size " + short_number(h) +
                         " s): the motion is too fast there (forces or parameters far out of range?)"
             : lost ? "the integrator lost control of its step size (step " + short_number(h) +
@@ -328,10 +374,13 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   // be met: a failed evaluation CVODE recovered from may be recorded before it).
   const bool theirs = flag == CV_RHSFUNC_FAIL || flag == CV_FIRST_RHSFUNC_ERR || flag == CV_REPTD_RHSFUNC_ERR ||
                       flag == CV_UNREC_RHSFUNC_ERR || flag == CV_LSETUP_FAIL || flag == CV_CONV_FAILURE;
-  if (theirs && eq.failure != Equations::Failure::none) {
+  if (theirs && eq.failure != Equations::Failure::none && !std::isfinite(eq.failed_time)) {
+    why = "the integrator lost control of its step size (its time is no longer finite): the forces or parameters "
+          "are far out of range?";
+  } else if (theirs && eq.failure != Equations::Failure::none) {
     t = eq.failed_time;
     why = eq.reason();
-  } else if (eq.failure != Equations::Failure::none) {  // a likely cause: say so, as such
+  } else if (eq.failure != Equations::Failure::none && std::isfinite(eq.failed_time)) {  // a likely cause: say so, as such
     why += "; the last evaluation that failed on the way, at t = " + short_number(eq.failed_time) + " s: " + eq.reason();
   }
   throw SimulationError("simulate: the integration stopped " + at_time(t) + ": " + why +
@@ -357,11 +406,10 @@ void configure(Cvode& cv, Equations& eq, const SimulationOptions& o, std::string
   check(CVodeSetMaxHnilWarns(cv.mem, -1), "CVodeSetMaxHnilWarns");  // no messages on stderr
 }
 
-// Stores sample j: the state, the inputs and the outputs at t.
-void record(SimulationResult& r, Index j, double t, Cvode& cv, Equations& eq) {
+// Stores sample j: the state x, the inputs and the outputs at t.
+void record(SimulationResult& r, Index j, double t, const double* x, Equations& eq) {
   const ModelKernels& k = eq.kernels();
   const Index n = eq.size();
-  const double* x = N_VGetArrayPointer(cv.x);
   r.t[j] = t;
   r.y.col(j) = Eigen::Map<const VectorXd>(x, n);
   r.yd.col(j) = Eigen::Map<const VectorXd>(x + n, n);
@@ -369,10 +417,15 @@ void record(SimulationResult& r, Index j, double t, Cvode& cv, Equations& eq) {
     throw SimulationError("simulate: the state is not finite " + at_time(t), t);
   r.u.col(j) = eq.inputs_at(t);
   const std::vector<double>& p = eq.parameters();
+  const double* tree = nullptr;  // closed loops followed: the tree's coordinates at the sample
+  if (eq.follows_loops() && !(tree = eq.closed(x)))
+    throw SimulationError("simulate: the kinematic loops could not be closed " + at_time(t), t);
   if (k.assemble && k.constraints && k.n_constraints > 0) {  // closed loops: Φ at the sample
-    std::vector<double> tree(static_cast<std::size_t>(k.n_tree_coordinates)), phi(static_cast<std::size_t>(k.n_constraints));
-    if (k.assemble(x, p.data(), tree.data()) != 0 || k.constraints(tree.data(), p.data(), phi.data()) != 0)
+    std::vector<double> own(static_cast<std::size_t>(k.n_tree_coordinates)), phi(static_cast<std::size_t>(k.n_constraints));
+    if (!tree && k.assemble(x, p.data(), own.data()) != 0)
       throw SimulationError("simulate: the kinematic loops could not be closed " + at_time(t), t);
+    if (k.constraints(tree ? tree : own.data(), p.data(), phi.data()) != 0)
+      throw SimulationError("simulate: the constraints are not finite " + at_time(t), t);
     for (double v : phi) r.constraint_drift = std::max(r.constraint_drift, std::abs(v));
   }
   if (r.z.rows() == 0) return;
@@ -380,9 +433,13 @@ void record(SimulationResult& r, Index j, double t, Cvode& cv, Equations& eq) {
   if (k.outputs_general) {
     if (!eq.evaluate(t, x, x + n)) throw SimulationError("simulate: " + eq.reason() + " " + at_time(t), t);
     const VectorXd u = r.u.col(j);
-    status = k.outputs_general(x, x + n, eq.accelerations().data(), u.data(), p.data(), r.z.col(j).data());
+    const double* ydd = eq.accelerations().data();
+    if (tree && !(tree = eq.closed(x)))  // again: evaluate() closed the loops in the same buffer
+      throw SimulationError("simulate: the kinematic loops could not be closed " + at_time(t), t);
+    status = tree ? k.outputs_general_full(tree, x + n, ydd, u.data(), p.data(), r.z.col(j).data())
+                  : k.outputs_general(x, x + n, ydd, u.data(), p.data(), r.z.col(j).data());
   } else {
-    status = k.outputs(x, x + n, p.data(), r.z.col(j).data());
+    status = tree ? k.outputs_full(tree, x + n, p.data(), r.z.col(j).data()) : k.outputs(x, x + n, p.data(), r.z.col(j).data());
   }
   if (status != 0) throw SimulationError("simulate: the outputs are not finite " + at_time(t), t);
 }
@@ -449,6 +506,57 @@ void restart(Cvode& cv, Equations& eq, SimulationResult& r, double t) {
   ++r.restarts;
 }
 
+// The integrator's steps, one at a time (each accepted step moves the closed loops' anchor), up
+// to the stops and past the samples.
+class Stepper {
+ public:
+  Stepper(Cvode& cv, Equations& eq, SimulationResult& r, const SimulationOptions& o, const std::string& message)
+      : cv_(cv), eq_(eq), r_(r), o_(o), message_(message), stops_(stop_times(o)), next_(stops_.begin()) {}
+
+  // The sample time for `t`: a sample within rounding of the next stop is taken at the stop
+  // (after a restart the integrator cannot start a step of a few ulps).
+  double sample_time(double t) {
+    t = std::min(o_.duration, t);
+    if (next_ != stops_.end() && std::abs(next_->t - t) <= window(o_, t)) t = next_->t;
+    if (t >= t_) pass_stops();  // not before the samples behind the integrator are taken
+    return t;
+  }
+  // Steps until the integrator reaches tout or passes it; true when it stands at tout (the state
+  // is cv.x), false when past it (interpolate). A restart at a stop waits until the samples
+  // before it are taken from the old history.
+  bool step_to(double tout) {
+    long steps = 0;
+    while (t_ < tout) {
+      pass_stops();
+      const double stop = next_ != stops_.end() ? next_->t : o_.duration;
+      if (CVodeSetStopTime(cv_.mem, stop) != CV_SUCCESS)
+        throw SimulationError("simulate: cannot stop at t = " + short_number(stop) + " s (internal error)", t_);
+      if (++steps > kMaxStepsPerSample) integration_failed(CV_TOO_MUCH_WORK, cv_, eq_, message_, t_);
+      double reached = t_;
+      eq_.failure = Equations::Failure::none;
+      const int flag = CVode(cv_.mem, std::min(tout, stop), cv_.x, &reached, CV_ONE_STEP);
+      if (flag < 0 || !std::isfinite(reached)) integration_failed(flag < 0 ? flag : CV_BAD_T, cv_, eq_, message_, t_);
+      t_ = reached;
+      if (eq_.follows_loops()) eq_.advance(N_VGetArrayPointer(cv_.x));
+    }
+    return t_ == tout;
+  }
+
+ private:
+  void pass_stops() {
+    for (; next_ != stops_.end() && t_ >= next_->t; ++next_)
+      if (next_->restart) restart(cv_, eq_, r_, next_->t);
+  }
+  Cvode& cv_;
+  Equations& eq_;
+  SimulationResult& r_;
+  const SimulationOptions& o_;
+  const std::string& message_;
+  const std::vector<Stop> stops_;
+  std::vector<Stop>::const_iterator next_;
+  double t_ = 0;
+};
+
 Index sample_count(const SimulationOptions& o) { return static_cast<Index>(std::ceil(o.duration / o.step * (1 - 1e-12))) + 1; }
 
 }  // namespace
@@ -464,10 +572,14 @@ SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op,
   VectorXd y, yd;
   initial_state(model, op, o, y, yd);
   Equations eq(model, o);
+  if (eq.follows_loops() && !eq.close_initial(op.y0, y))
+    throw SimulationError("simulate: the kinematic loops cannot be closed at the initial state (from the operating "
+                          "point's configuration by continuation)", 0.0);
   Cvode cv(2 * n, o.method);
   std::string message;
-  Eigen::Map<VectorXd>(N_VGetArrayPointer(cv.x), n) = y;
-  Eigen::Map<VectorXd>(N_VGetArrayPointer(cv.x) + n, n) = yd;
+  double* x = N_VGetArrayPointer(cv.x);
+  Eigen::Map<VectorXd>(x, n) = y;
+  Eigen::Map<VectorXd>(x + n, n) = yd;
   if (!eq.evaluate(0.0, y.data(), yd.data()))
     throw SimulationError("simulate: the initial state fails " + at_time(0) + ": " + eq.reason(), 0.0);
   configure(cv, eq, o, message);
@@ -475,30 +587,24 @@ SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op,
   const Index samples = sample_count(o);
   SimulationResult r = allocated(k, samples);
   r.analytic_jacobian = eq.analytic_jacobian();
-  record(r, 0, 0.0, cv, eq);
-  const std::vector<Stop> stops = stop_times(o);
-  auto next = stops.begin();
-  double t = 0;
+  record(r, 0, 0.0, x, eq);
+  Stepper stepper(cv, eq, r, o, message);
+  VectorXd sample(2 * n);
+  N_Vector sample_vector = N_VMake_Serial(2 * n, sample.data(), cv.context);
+  if (!sample_vector) throw Error("simulate: out of memory for the integrator");
+  struct Release {
+    N_Vector v;
+    ~Release() { N_VDestroy(v); }
+  } release{sample_vector};
   for (Index j = 1; j < samples; ++j) {
-    double tout = j + 1 == samples ? o.duration : std::min(o.duration, static_cast<double>(j) * o.step);
-    // A sample within rounding of a stop is taken at the stop (after a restart the integrator
-    // cannot start a step of a few ulps).
-    if (next != stops.end() && std::abs(next->t - tout) <= window(o, tout)) tout = next->t;
-    while (t < tout) {
-      const double stop = next != stops.end() ? next->t : o.duration;
-      if (CVodeSetStopTime(cv.mem, stop) != CV_SUCCESS)
-        throw SimulationError("simulate: cannot stop at t = " + short_number(stop) + " s (internal error)", t);
-      double reached = t;
-      eq.failure = Equations::Failure::none;
-      const int flag = CVode(cv.mem, std::min(tout, stop), cv.x, &reached, CV_NORMAL);
-      if (flag < 0) integration_failed(flag, cv, eq, message);
-      t = reached;
-      if (next != stops.end() && t >= next->t) {
-        if (next->restart) restart(cv, eq, r, next->t);
-        ++next;
-      }
+    const double tout = stepper.sample_time(j == samples - 1 ? o.duration : static_cast<double>(j) * o.step);
+    if (stepper.step_to(tout)) {
+      record(r, j, tout, x, eq);
+    } else {  // the last step went past the sample: CVODE's interpolant there
+      if (CVodeGetDky(cv.mem, tout, 0, sample_vector) != CV_SUCCESS)
+        throw SimulationError("simulate: cannot interpolate " + at_time(tout) + " (internal error)", tout);
+      record(r, j, tout, sample.data(), eq);
     }
-    record(r, j, tout, cv, eq);
     if (o.progress) o.progress(tout);
   }
   add_statistics(cv, r);

@@ -98,6 +98,16 @@ struct ModelKernels {
   int n_tree_coordinates = 0, n_constraints = 0;
   int (*assemble)(const double* yi, const double* p, double* y) = nullptr;
   int (*constraints)(const double* y, const double* p, double* phi) = nullptr;
+  /// Closed loops, for a simulation that follows the motion through any range: `assemble`
+  /// starting from the tree coordinates y holds on entry (Newton from a nearby closed
+  /// configuration), and `dynamics`, `outputs` and `outputs_general` in the tree's coordinates y (closed)
+  /// with the independent rates (null: not emitted, or generated before them). Trailing.
+  int (*assemble_from)(const double* yi, const double* p, double* y) = nullptr;
+  int (*dynamics_full)(const double* y, const double* yd, const double* u, const double* p, double* M,
+                       double* r) = nullptr;
+  int (*outputs_full)(const double* y, const double* yd, const double* p, double* z) = nullptr;
+  int (*outputs_general_full)(const double* y, const double* yd, const double* ydd, const double* u,
+                              const double* p, double* z) = nullptr;
 };
 
 /// The first n entries of a kernel name array (null entries become "").
