@@ -1162,6 +1162,26 @@ SceneSelection emitted_scene(const Model& model) {
   return scene;
 }
 
+// The kernels of a time step (dynamics, dynamics_jacobian): asked for (EmitOptions::dynamics) of
+// the full model, or by a scene's `simulate`.
+bool wants_dynamics(const SceneSelection& scene, const EmitOptions& options) {
+  return (options.dynamics && scene.full) || scene.asks(Analysis::simulate);
+}
+
+void check_dynamics(const SceneSelection& scene, const EmitOptions& options, const LinearEquations& lin) {
+  const bool simulate = scene.asks(Analysis::simulate);
+  if (lin.descriptor && (options.dynamics || simulate))
+    throw std::invalid_argument(
+        std::string(simulate ? "scene '" + scene.name + "' asks for simulate, whose" : "the") +
+        " dynamics kernel (--dynamics) needs the second-order form M(y) ydd + k - q = 0, which a model with "
+        "nonholonomic constraints does not have (its kernels are the descriptor form's)");
+  if (options.dynamics && !scene.full && !simulate)
+    throw std::invalid_argument("the dynamics kernel (--dynamics) is for the full model or a scene that asks for "
+                                "simulate: scene '" + scene.name +
+                                "' does not (add simulate to its analyses; a scene without it prunes, at rest, the "
+                                "velocity terms a time step needs)");
+}
+
 // The kernels' C identifier prefix (EmitOptions::id).
 std::string emitted_id(const Model& model, const EmitOptions& options) {
   const SceneSelection& scene = model.selection();
@@ -1175,11 +1195,10 @@ std::string emitted_id(const Model& model, const EmitOptions& options) {
   return id;
 }
 
-// The scene kernel each kernel comes with (SceneSelection::emits; dynamics: asked for, of the full
-// model only).
+// The scene kernel each kernel comes with (SceneSelection::emits; dynamics: see wants_dynamics).
 std::string scene_kernel(const std::string& name) {
   if (name == "outputs_general") return "outputs";
-  if (name == "dynamics" || name == "dynamics_jacobian") return "mass_matrix";
+  if (name == "dynamics" || name == "dynamics_jacobian") return "dynamics";
   if (name == "output_terms" || name == "descriptor" || name == "reduced" || name == "reduced_parts") return "linear";
   return name;
 }
@@ -1284,7 +1303,7 @@ std::vector<Kernel> derivation_only_kernels(const Model& model, const Equations&
   const SceneSelection scene = emitted_scene(model);
   const std::vector<ex> y(eq.y.begin(), eq.y.end()), yd(eq.yd.begin(), eq.yd.end()), p(eq.p.begin(), eq.p.end());
   std::vector<Kernel> all, kernels;
-  derivation_kernels(eq, y, yd, p, eq.y.size(), options.dynamics && scene.full, all);
+  derivation_kernels(eq, y, yd, p, eq.y.size(), wants_dynamics(scene, options), all);
   all.push_back(bodies_kernel(eq, model.bodies().size(), y, p, eq.y.size()));
   for (Kernel& k : all)
     if (scene.emits(scene_kernel(k.name))) kernels.push_back(std::move(k));
@@ -1384,13 +1403,8 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   out.id = emitted_id(model, options);
   const bool loops = eq.loops.active;
   const std::size_t n = eq.y.size();
-  if (options.dynamics && (lin.descriptor || !model.selection().full))
-    throw std::invalid_argument(
-        lin.descriptor ? "the dynamics kernel (--dynamics) needs the second-order form M(y) ydd + k - q = 0, which a "
-                         "model with nonholonomic constraints does not have (its kernels are the descriptor form's)"
-                       : "the dynamics kernel (--dynamics) is emitted for the full model only: scene '" + model.selection().name +
-                             "' prunes effects and, at rest, the velocity terms a time step needs");
-  std::vector<Kernel> kernels = model_kernels(model, eq, lin, options.dynamics);
+  check_dynamics(scene, options, lin);
+  std::vector<Kernel> kernels = model_kernels(model, eq, lin, wants_dynamics(scene, options));
   std::ostringstream kernel_code;
   std::vector<std::pair<std::string, std::size_t>> chunks;  // definitions of kernel parts, operations
   if (loops) {

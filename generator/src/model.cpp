@@ -61,6 +61,7 @@ const char* to_string(Analysis analysis) {
     case Analysis::modes: return "modes";
     case Analysis::frf: return "frf";
     case Analysis::statics: return "static";
+    case Analysis::simulate: return "simulate";
   }
   return "";
 }

@@ -12,11 +12,15 @@ namespace mbsgen {
 using GiNaC::ex;
 
 std::vector<std::string> SceneSelection::all_kernels() {
-  return {"mass_matrix", "residual", "linear", "linear_structured", "operating_point", "outputs", "bodies"};
+  return {"mass_matrix", "residual", "linear", "linear_structured", "operating_point", "outputs", "bodies", "dynamics"};
 }
 
 bool SceneSelection::emits(const std::string& kernel) const {
   return std::find(kernels.begin(), kernels.end(), kernel) != kernels.end();
+}
+
+bool SceneSelection::asks(Analysis analysis) const {
+  return std::find(analyses.begin(), analyses.end(), analysis) != analyses.end();
 }
 
 std::vector<std::string> kernels_of(Analysis analysis) {
@@ -24,6 +28,9 @@ std::vector<std::string> kernels_of(Analysis analysis) {
     case Analysis::modes: return {"linear", "linear_structured"};
     case Analysis::frf: return {"linear"};
     case Analysis::statics: return {"residual", "linear"};
+    // The operating point's equilibrium, when the model asks for one, takes its Jacobian from
+    // dynamics_jacobian (GeneratedModel::operating_point): no `linear`.
+    case Analysis::simulate: return {"mass_matrix", "residual", "dynamics", "outputs"};
   }
   return {};
 }
@@ -185,7 +192,7 @@ void check_scene(const Model& model, const Scene& scene) {
     }
 
   if (scene.analyses.empty())
-    throw ModelError(scene.where, "scene '" + scene.name + "' asks for no analysis (modes, frf, static)");
+    throw ModelError(scene.where, "scene '" + scene.name + "' asks for no analysis (modes, frf, static, simulate)");
   for (std::size_t i = 0; i < scene.analyses.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (scene.analyses[i] == scene.analyses[j])
@@ -246,6 +253,11 @@ Model apply_scene(const Model& model, const std::string& name) {
   // The operating point, overridden per coordinate.
   const OperatingPointOverride& op = scene->operating_point;
   if (op.kind) m.operating_point_.kind = *op.kind;
+  // A simulation's equilibrium takes its Jacobian from dynamics_jacobian, which a model with
+  // loops does not have: `linear` then.
+  if (asks(Analysis::simulate) && m.operating_point_.kind == OperatingPoint::Kind::equilibrium &&
+      !model.constraints().empty() && !sel.emits("linear"))
+    sel.kernels.insert(std::find(sel.kernels.begin(), sel.kernels.end(), "residual") + 1, "linear");
   for (const auto& [c, v] : op.position) m.operating_point_.position[c] = v;
   for (const auto& [c, v] : op.velocity) m.operating_point_.velocity[c] = v;
   if (op.where.line > 0) m.operating_point_.where = op.where;
@@ -268,7 +280,7 @@ Model apply_scene(const Model& model, const std::string& name) {
   std::vector<std::string> inputs;
   if (scene->inputs) {
     for (const auto& it : *scene->inputs) inputs.push_back(it.name);
-  } else if (asks(Analysis::frf) || asks(Analysis::statics)) {
+  } else if (asks(Analysis::frf) || asks(Analysis::statics) || asks(Analysis::simulate)) {
     for (const auto& i : model.inputs()) inputs.push_back(i.name);
   }
   GiNaC::exmap dropped;
@@ -352,11 +364,13 @@ Model apply_scene(const Model& model, const std::string& name) {
   }
 
   // Velocity-quadratic inertia terms: their value and first derivatives vanish at ẏ = 0, so
-  // about rest they cannot reach M, Q, K, nor the residual of a static equilibrium.
+  // about rest they cannot reach M, Q, K, nor the residual of a static equilibrium; a simulation
+  // leaves rest, and keeps them.
   const bool gyroscopic = active("gyroscopic", Category::gyroscopic);
-  m.inertial_velocity_terms_ = gyroscopic && !at_rest;
+  const bool simulates = asks(Analysis::simulate);
+  m.inertial_velocity_terms_ = gyroscopic && (!at_rest || simulates);
   record("gyroscopic", Category::gyroscopic, m.inertial_velocity_terms_,
-         gyroscopic && at_rest ? "cannot contribute at rest (yd0 = 0)" : "");
+         gyroscopic && at_rest && !simulates ? "cannot contribute at rest (yd0 = 0)" : "");
   for (const auto& i : model.inputs())
     sel.effects.push_back({i.name, "inputs", std::find(inputs.begin(), inputs.end(), i.name) != inputs.end(), ""});
 
@@ -364,7 +378,7 @@ Model apply_scene(const Model& model, const std::string& name) {
   std::vector<std::string> outputs;
   if (scene->outputs) {
     for (const auto& it : *scene->outputs) outputs.push_back(it.name);
-  } else if (asks(Analysis::frf)) {
+  } else if (asks(Analysis::frf) || asks(Analysis::simulate)) {
     for (const auto& o : model.outputs()) outputs.push_back(o.name);
   }
   m.outputs_.clear();

@@ -1557,11 +1557,11 @@ void Reader::read_scene(const YAML::Node& n) {
   const std::string what = "scene '" + s.name + "'";
   if (const Entry* d = find(f, "description")) s.description = scalar(value(*d), "a description");
   if (const Entry* a = find(f, "analyses")) {
-    static const std::vector<std::string> known = {"modes", "frf", "static"};
+    static const std::vector<std::string> known = {"modes", "frf", "static", "simulate"};
     s.analyses.clear();
     std::map<std::string, SourceLocation> seen;
     for (const auto& an : list(a, "the analyses of " + what)) {
-      const std::string k = scalar(an, "an analysis (modes, frf or static)");
+      const std::string k = scalar(an, "an analysis (modes, frf, static or simulate)");
       if (std::find(known.begin(), known.end(), k) == known.end()) {
         std::string hint = suggestion(k, known);
         if (hint.empty()) hint = " (one of: " + join(known) + ")";
@@ -1569,9 +1569,12 @@ void Reader::read_scene(const YAML::Node& n) {
       }
       if (auto [at, inserted] = seen.emplace(k, loc(an)); !inserted)
         fail(an, "'" + k + "' is listed twice in " + what + " (first at " + at->second.str() + ")");
-      s.analyses.push_back(k == "modes" ? Analysis::modes : k == "frf" ? Analysis::frf : Analysis::statics);
+      s.analyses.push_back(k == "modes"    ? Analysis::modes
+                           : k == "frf"    ? Analysis::frf
+                           : k == "static" ? Analysis::statics
+                                           : Analysis::simulate);
     }
-    if (s.analyses.empty()) fail(a->key, what + " asks for no analysis (modes, frf, static)");
+    if (s.analyses.empty()) fail(a->key, what + " asks for no analysis (modes, frf, static, simulate)");
   }
   if (const Entry* e = find(f, "effects")) s.effects = items(*e, "the effects of " + what);
   if (const Entry* e = find(f, "without")) s.without = items(*e, "the effects " + what + " is without");

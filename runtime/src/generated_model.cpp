@@ -52,9 +52,9 @@ GeneratedModel::GeneratedModel(const ModelKernels& kernels) : k_(kernels) {
     throw Error("GeneratedModel: model '" + std::string(k_.id) + "' has kernel ABI version " +
                 std::to_string(k_.abi_version) + ", this runtime expects " +
                 std::to_string(kKernelAbiVersion) + "; regenerate it");
-  if (!k_.operating_point || (!k_.linear && !k_.descriptor))
+  if (!k_.operating_point || (!k_.linear && !k_.descriptor && !k_.dynamics))
     throw Error("GeneratedModel: model '" + std::string(k_.id) +
-                "' lacks the operating_point or linear kernel (its scene asks for no linear analysis)");
+                "' lacks the operating_point kernel, or has neither the linear kernel nor those of a time step");
   parameter_names_ = name_list(k_.parameter_names, k_.n_parameters);
   p_.assign(k_.parameter_defaults, k_.parameter_defaults + k_.n_parameters);
 }
@@ -128,14 +128,24 @@ OperatingPoint GeneratedModel::operating_point() const {
   const Eigen::Index m = k_.n_inputs, r = k_.n_outputs;
   Eigen::MatrixXd M(f, f), Q(f, f), B(f, std::max<Eigen::Index>(m, 1)), Cy(std::max<Eigen::Index>(r, 1), f),
       Cv(std::max<Eigen::Index>(r, 1), f);
+  if (!k_.linear && !k_.dynamics_jacobian)
+    throw Error("operating_point: model '" + std::string(k_.model) + "' (scene '" + k_.scene +
+                "') has an equilibrium operating point but neither the linear nor the dynamics_jacobian kernel");
+  const Eigen::VectorXd ydd0 = Eigen::VectorXd::Zero(f);
+  const std::vector<double> u0(static_cast<std::size_t>(std::max<Eigen::Index>(m, 1)), 0.0);
   StaticEquilibrium newton(f);
   newton.compute(
       [&](const Eigen::VectorXd& y, Eigen::VectorXd& res) { res = residual(y, yd0); },
       [&](const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
         J.resize(f, f);
-        check_status(k_.linear(y.data(), yd0.data(), p_.data(), M.data(), Q.data(), J.data(),
-                               B.data(), Cy.data(), Cv.data()),
-                     "linear", k_.model);
+        if (k_.linear) {
+          check_status(k_.linear(y.data(), yd0.data(), p_.data(), M.data(), Q.data(), J.data(), B.data(), Cy.data(),
+                                 Cv.data()),
+                       "linear", k_.model);
+        } else {  // a scene that only simulates: K = ∂(k − q)/∂y = K_y at ÿ = 0, u = 0
+          check_status(k_.dynamics_jacobian(y.data(), yd0.data(), ydd0.data(), u0.data(), p_.data(), J.data(), Q.data()),
+                       "dynamics_jacobian", k_.model);
+        }
       },
       op.y0);
   newton.throw_if_failed();
@@ -210,9 +220,12 @@ std::vector<std::pair<std::string, Eigen::MatrixXd>> GeneratedModel::reduced_par
 }
 
 LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
-  if (!k_.linear)
+  if (!k_.linear && k_.descriptor)
     throw Error("model '" + std::string(k_.model) + "' has nonholonomic constraints: its linear model is first order, "
                 "E x' = A x + B u (GeneratedModel::descriptor_model)");
+  if (!k_.linear)
+    throw Error("model '" + std::string(k_.model) + "', scene '" + k_.scene +
+                "': no linear kernel (the scene asks for no linear analysis: modes, frf or static)");
   const Eigen::Index f = size(), m = k_.n_inputs, r = k_.n_outputs;
   if (op.y0.size() != f || op.yd0.size() != f)
     throw DimensionError("GeneratedModel::linear_model: operating point of size " +

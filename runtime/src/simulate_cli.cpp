@@ -193,7 +193,7 @@ int run_simulate(const ModelKernels& k, const SimulateOptions& o, std::ostream& 
     err << "\rsimulate: t = " << short_num(t) << " s (" << static_cast<int>(100 * t / s.duration) << " %)" << std::flush;
     progress_shown = true;
   };
-  if (o.method == "bdf" && !k.dynamics_jacobian && !o.difference_quotients)
+  if (o.method == "bdf" && k.mass_matrix && k.residual && !k.dynamics_jacobian && !o.difference_quotients)
     err << "note: the kernels have no dynamics_jacobian (generate with --dynamics): iteration matrices from "
            "difference quotients\n";
   SimulationResult r;

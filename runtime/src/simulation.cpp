@@ -313,8 +313,9 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   const ModelKernels& k = model.kernels();
   if (!k.mass_matrix || !k.residual)
     throw Error("simulate: model '" + std::string(k.model) + "' (scene '" + k.scene +
-                "') has no second-order kernels mass_matrix and residual (a model with rolling constraints, or a "
-                "scene without them)");
+                "') has no second-order kernels mass_matrix and residual: " +
+                (std::string(k.scene) == "full" ? "its kernels are the descriptor form of a model with rolling constraints"
+                                                : "the scene does not ask for simulate (add it to its analyses)"));
   auto positive = [](double v, const char* what) {
     if (!(std::isfinite(v) && v > 0))
       throw Error(std::string("simulate: ") + what + " must be a finite number > 0, got " + std::to_string(v));

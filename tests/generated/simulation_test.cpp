@@ -8,6 +8,8 @@
 #include "four_bar_model.hpp"
 #include "jeffcott_rotor_model.hpp"
 #include "middle_ear_model.hpp"
+#include "rotor_disk_model.hpp"
+#include "rotor_disk_motion_model.hpp"
 #include "simple_pendulum_model.hpp"
 #include "spherical_pendulum_conical_model.hpp"
 #include "ziegler_column_model.hpp"
@@ -605,6 +607,43 @@ TEST(Simulation, FourBarCrankTurnsFully) {
     EXPECT_LT(drift[2], 1e-8) << "start " << start;
     EXPECT_LT(drift[2], drift[0] / 10) << "start " << start << ": " << drift[0] << " at rtol 1e-10";
   }
+}
+
+// A scene that asks for simulate (models/textbook/rotor_disk.yaml, `motion`): linearized at
+// standstill, it still keeps the velocity-quadratic inertia terms (a simulation leaves rest) and
+// has the kernels of a time step without --dynamics, but not `linear`. Released at α = A with
+// γ' = Ω, the tilt whirls as z = α + iβ = A (−ω2 e^{iω1 t} + ω1 e^{iω2 t})/(ω1 − ω2), the roots
+// of I_d ω² − I_p Ω ω − k_t = 0 (161.80 and −61.80 rad/s); without the gyroscopic terms α would
+// be A cos(100 t). Bound: 1e-7 A, the integration error at rtol 1e-11 over 5 slow periods (the
+// nonlinearity's part is O(A²) = 1e-12 of A). The full model (difference-quotient Jacobians)
+// gives the same motion to the same bound.
+TEST(Simulation, SceneKeepsWhatMotionNeeds) {
+  GeneratedModel scene(rotor_disk_motion::kernels());
+  EXPECT_STREQ(scene.kernels().scene, "motion");
+  EXPECT_NE(scene.kernels().dynamics_jacobian, nullptr);
+  EXPECT_EQ(scene.kernels().linear, nullptr);
+  GeneratedModel full(rotor_disk::kernels());
+  const std::vector<double>& p = scene.parameters();  // m, I_d, I_p, k_t, Omega
+  const double Id = p[1], Ip = p[2], kt = p[3], Omega = p[4], A = 1e-6;
+  const double root = std::sqrt(Ip * Ip * Omega * Omega + 4 * Id * kt);
+  const double w1 = (Ip * Omega + root) / (2 * Id), w2 = (Ip * Omega - root) / (2 * Id);
+  SimulationOptions o;
+  o.duration = 0.5;
+  o.step = 1e-3;
+  o.rtol = 1e-11;
+  o.atol = 1e-19;
+  o.initial = {{"alpha", A}, {"gamma_dot", Omega}};
+  const SimulationResult r = run(scene, o), rf = run(full, o);
+  ASSERT_TRUE(r.analytic_jacobian);
+  double worst = 0, worst_full = 0;
+  for (Eigen::Index j = 0; j < r.t.size(); ++j) {
+    const std::complex<double> i(0, 1), t = r.t[j];
+    const std::complex<double> z = A * (-w2 * std::exp(i * w1 * t) + w1 * std::exp(i * w2 * t)) / (w1 - w2);
+    worst = std::max({worst, std::abs(r.y(0, j) - z.real()), std::abs(r.y(1, j) - z.imag())});
+    worst_full = std::max(worst_full, (r.y.col(j).head(2) - rf.y.col(j).head(2)).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-7 * A);
+  EXPECT_LT(worst_full, 1e-7 * A);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -229,6 +230,51 @@ TEST(Scenes, PrunedModel) {
   EXPECT_EQ(full.selection().kernels, SceneSelection::all_kernels());
 }
 
+// A scene that asks for simulate emits the kernels of a time step (dynamics and its Jacobian,
+// without --dynamics) and keeps what a motion needs: the velocity-quadratic terms even at rest,
+// every input and output by default; not `linear`, unless loops need it for an equilibrium. A
+// scene without simulate refuses --dynamics (it may have pruned those terms).
+TEST(Scenes, SimulateKeepsWhatATimeStepNeeds) {
+  const Model rotor = read_model_file(kSourceDir + "/models/textbook/rotor_disk.yaml");
+  const Model motion = apply_scene(rotor, "motion");
+  EXPECT_TRUE(motion.inertial_velocity_terms());
+  EXPECT_EQ(motion.selection().kernels,
+            (std::vector<std::string>{"mass_matrix", "residual", "operating_point", "outputs", "dynamics"}));
+  EXPECT_EQ(motion.inputs().size(), rotor.inputs().size());
+  EXPECT_EQ(motion.outputs().size(), rotor.outputs().size());
+  const Generated g = generate(rotor, "motion");
+  std::set<std::string> names;
+  for (const auto& k : g.code.kernels) names.insert(k.name);
+  EXPECT_EQ(names, (std::set<std::string>{"mass_matrix", "residual", "dynamics", "dynamics_jacobian",
+                                          "operating_point", "outputs"}));
+
+  Model rest = apply_scene(rotor, "modes_at_rest");
+  Equations eq = derive(rest);
+  LinearEquations lin = linearize(eq);
+  EmitOptions options;
+  options.dynamics = true;
+  try {
+    emit(rest, eq, lin, options);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("scene 'modes_at_rest' does not (add simulate to its analyses"),
+              std::string::npos) << e.what();
+  }
+
+  // The four-bar (closed loop, equilibrium operating point): `linear` for the equilibrium's
+  // Jacobian, as the loops have no dynamics_jacobian.
+  std::string text;
+  {
+    std::ifstream in(kSourceDir + "/models/linkages/four_bar.yaml");
+    std::stringstream all;
+    all << in.rdbuf();
+    text = all.str() + "  - {name: swing, analyses: [simulate]}\n";
+  }
+  const Model swing = apply_scene(read_model_string(text, "four_bar.yaml"), "swing");
+  EXPECT_EQ(swing.selection().kernels,
+            (std::vector<std::string>{"mass_matrix", "residual", "linear", "operating_point", "outputs", "dynamics"}));
+}
+
 TEST(Scenes, UnknownSceneNamesTheKnownOnes) {
   const Model rotor = read_model_file(kSourceDir + "/models/textbook/rotor_disk.yaml");
   try {
@@ -236,7 +282,7 @@ TEST(Scenes, UnknownSceneNamesTheKnownOnes) {
     ADD_FAILURE() << "no error";
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(), "model 'rotor_disk' has no scene 'spining' (did you mean 'spinning'?) "
-                           "(scenes: full, modes_at_rest, spinning)");
+                           "(scenes: full, modes_at_rest, spinning, motion)");
   }
 }
 

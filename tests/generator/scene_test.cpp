@@ -180,9 +180,51 @@ TEST_P(SceneEqualsZeroedFullModel, AtTheScenesOperatingPoint) {
 INSTANTIATE_TEST_SUITE_P(Scenes, SceneEqualsZeroedFullModel, ::testing::ValuesIn(kCases),
                          [](const auto& param_info) { return std::string(param_info.param.scene); });
 
+// Scenes that ask for simulate only (no linear kernel): M(y) and k − q(y, ẏ, u) equal the full
+// model's with the scene's inactive parameters zero at any state, rates included (such a scene
+// keeps the velocity-quadratic terms even when linearized at rest). Rounding bound as above, of
+// the size of the terms: K y, the inputs' loads and the rates' inertia forces M ẏ².
+const SceneCase kMotionCases[] = {
+    {"rotor_disk_motion", "rotor_disk", {}},
+};
+
+TEST(Scenes, SimulateSceneEqualsTheFullModelAtAnyState) {
+  for (const SceneCase& c : kMotionCases) {
+    const GeneratedScene& s = scene(c.scene);
+    const GeneratedModel& g = full_model(c.full);
+    ASSERT_EQ(s.linear, nullptr) << c.scene;
+    ASSERT_TRUE(s.mass_matrix && s.residual && g.mass_matrix && g.residual) << c.scene;
+    ASSERT_EQ(s.n, g.n);
+    const VectorXd p = Eigen::Map<const VectorXd>(s.defaults, s.np);
+    VectorXd p_zeroed = p;
+    for (const char* name : c.zeroed) p_zeroed[index_of(g.parameter_names, g.np, name)] = 0;
+    for (int trial = 0; trial < 3; ++trial) {
+      VectorXd y(s.n), yd(s.n), u(s.nu), u_full = VectorXd::Zero(g.nu);
+      for (int i = 0; i < s.n; ++i) {
+        y[i] = 0.4 * std::sin(1.3 * (i + 1) + trial);
+        yd[i] = 20 * std::cos(0.7 * (i + 1) + 2 * trial);
+      }
+      for (int j = 0; j < s.nu; ++j) {
+        u[j] = 2.0 * std::cos(0.9 * (j + 1) + trial);
+        u_full[index_of(g.input_names, g.nu, s.input_names[j])] = u[j];
+      }
+      MatrixXd Ma(s.n, s.n), Mb(g.n, g.n);
+      VectorXd ra(s.n), rb(g.n);
+      ASSERT_EQ(s.mass_matrix(y.data(), p.data(), Ma.data()), 0);
+      ASSERT_EQ(g.mass_matrix(y.data(), p_zeroed.data(), Mb.data()), 0);
+      expect_same(Ma, Mb, "M");
+      ASSERT_EQ(s.residual(y.data(), yd.data(), u.data(), p.data(), ra.data()), 0);
+      ASSERT_EQ(g.residual(y.data(), yd.data(), u_full.data(), p_zeroed.data(), rb.data()), 0);
+      const double scale = std::max(rb.cwiseAbs().maxCoeff(), max_abs(Mb) * yd.squaredNorm());
+      EXPECT_LE((ra - rb).cwiseAbs().maxCoeff(), 1e-13 * scale) << c.scene << ", trial " << trial;
+    }
+  }
+}
+
 TEST(Scenes, EveryGeneratedSceneIsCompared) {
   std::set<std::string> compared;
   for (const auto& c : kCases) compared.insert(c.scene);
+  for (const auto& c : kMotionCases) compared.insert(c.scene);
   for (const auto& s : all_scenes()) EXPECT_TRUE(compared.count(s.name)) << s.name;
 }
 

@@ -164,7 +164,8 @@ TEST(ChainSympy, DecimalValuesAreExactInExpressionsAndRoundedAsParameters) {
 
 TEST(Scenes, ReadAsWritten) {
   const mbsgen::Model m = mbsgen::read_model_file(kSourceDir + "/models/textbook/rotor_disk.yaml");
-  ASSERT_EQ(m.scenes().size(), 2u);
+  ASSERT_EQ(m.scenes().size(), 3u);
+  EXPECT_EQ(m.scenes()[2].analyses, std::vector<mbsgen::Analysis>{mbsgen::Analysis::simulate});
   const mbsgen::Scene& rest = m.scenes()[0];
   EXPECT_EQ(rest.name, "modes_at_rest");
   EXPECT_EQ(rest.description, "natural frequencies of the disk at standstill");

@@ -259,10 +259,11 @@ struct OperatingPoint {
 enum class Analysis {
   modes,  ///< eigenvalues of λ²M + λQ + K: kernels linear and linear_structured
   frf,    ///< frequency responses: kernel linear (M, Q, K, B, C)
-  statics ///< static equilibrium by Newton's method: kernels residual and linear (K)
+  statics, ///< static equilibrium by Newton's method: kernels residual and linear (K)
+  simulate ///< time integration: mass_matrix, residual, dynamics (with its Jacobian), outputs
 };
 
-/// "modes", "frf", "static".
+/// "modes", "frf", "static", "simulate".
 const char* to_string(Analysis analysis);
 
 /// A name written in a scene, with its place in the model file.
@@ -336,9 +337,11 @@ struct SceneSelection {
   std::vector<EffectState> effects;
   std::optional<FrequencyRange> frequency_range;
 
-  /// mass_matrix, residual, linear, linear_structured, operating_point, outputs, bodies.
+  /// mass_matrix, residual, linear, linear_structured, operating_point, outputs, bodies, dynamics
+  /// (`dynamics` and `dynamics_jacobian`: in the full scene only with EmitOptions::dynamics).
   static std::vector<std::string> all_kernels();
   bool emits(const std::string& kernel) const;
+  bool asks(Analysis analysis) const;
 };
 
 struct Parameter {
