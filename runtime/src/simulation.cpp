@@ -1,6 +1,8 @@
 // simulate(): SUNDIALS CVODE on x' = (v, −M(y)⁻¹ (k − q)(y, v, u(t))), x = (y, v) (simulation.hpp).
 #include "mbsgen/runtime/simulation.hpp"
 
+#include "second_order_newton.hpp"
+
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
@@ -54,9 +56,10 @@ struct Cvode {
   void* mem = nullptr;
   Cvode(const Cvode&) = delete;
   Cvode& operator=(const Cvode&) = delete;
-  Cvode(sunindextype size, IntegrationMethod method) {
+  // `reduced`: BDF's Newton systems in n unknowns from the Jacobian kernel (second_order_newton.hpp).
+  Cvode(sunindextype size, IntegrationMethod method, bool reduced) {
     try {
-      create(size, method);
+      create(size, method, reduced);
     } catch (...) {
       release();
       throw;
@@ -65,7 +68,7 @@ struct Cvode {
   ~Cvode() { release(); }
 
  private:
-  void create(sunindextype size, IntegrationMethod method) {
+  void create(sunindextype size, IntegrationMethod method, bool reduced) {
     if (SUNContext_Create(nullptr, &context) != 0) throw Error("simulate: SUNContext_Create failed");
     x = N_VNew_Serial(size, context);
     mem = CVodeCreate(method == IntegrationMethod::adams ? CV_ADAMS : CV_BDF, context);
@@ -73,6 +76,10 @@ struct Cvode {
     if (method == IntegrationMethod::adams) {
       fixed_point = SUNNonlinSol_FixedPoint(x, 0, context);
       if (!fixed_point) throw Error("simulate: SUNNonlinSol_FixedPoint failed");
+    } else if (reduced) {
+      A = detail::new_second_order_matrix(size / 2, context);
+      solver = A ? detail::new_second_order_solver(size / 2, context) : nullptr;
+      if (!solver) throw Error("simulate: out of memory for the integrator's linear solver");
     } else {
       A = SUNDenseMatrix(size, size, context);
       solver = A ? SUNLinSol_Dense(x, A, context) : nullptr;
@@ -95,7 +102,7 @@ class Equations {
  public:
   Equations(const GeneratedModel& model, const SimulationOptions& o)
       : k_(model.kernels()), p_(model.parameters()), n_(k_.n_coordinates), options_(o),
-        M_(n_, n_), r_(n_), u_(k_.n_inputs), a_(n_), Ky_(n_, n_), Kv_(n_, n_) {}
+        M_(n_, n_), r_(n_), u_(k_.n_inputs), a_(n_), scale_(n_), scaled_(n_, n_), lu_(n_) {}
 
   // Closed loops, followed through any range: the tree's coordinates at the last accepted step
   // (`anchor_`), from which every evaluation closes the loops again (assemble_from).
@@ -168,37 +175,47 @@ class Equations {
       if (s == 0) s = k_.residual(y, yd, u_.data(), p_.data(), r_.data());
     }
     if (s != 0) return fail(t, s == 2 ? Failure::loops : Failure::non_finite);
-    lu_.compute(M_);
-    // Eigen's rcond() estimate is 1 for an exactly singular M (a zero pivot makes its solves
-    // inf or NaN): the pivots' ratio bounds the reciprocal condition number from above.
-    double rcond = 1.0;
-    if (n_ > 0) {
-      double smallest = kInfinity, largest = 0;
-      for (Index i = 0; i < n_; ++i) {
-        const double d = std::abs(lu_.matrixLU()(i, i));
-        smallest = std::min(smallest, d), largest = std::max(largest, d);
-      }
-      rcond = smallest / largest;
-      if (rcond > static_cast<double>(n_) * std::numeric_limits<double>::epsilon()) rcond = std::min(rcond, lu_.rcond());
-    }
-    if (!(rcond > static_cast<double>(n_) * std::numeric_limits<double>::epsilon())) {
-      rcond_ = rcond;
-      return fail(t, Failure::singular_mass);
-    }
+    if (!factor_mass()) return fail(t, Failure::singular_mass);
+    // ÿ = −S (S M S)⁻¹ S (k − q)
+    r_.array() *= scale_.array();
     a_.noalias() = lu_.solve(r_);
-    a_ = -a_;
+    a_.array() *= -scale_.array();
     if (!a_.allFinite()) return fail(t, Failure::non_finite);
     return true;
   }
-  // ∂ÿ/∂y = −M⁻¹ K_y(y, ẏ, ÿ) and ∂ÿ/∂ẏ = −M⁻¹ K_v after evaluate() at the same state.
-  bool jacobian(double t, const double* y, const double* yd, Eigen::Ref<MatrixXd> dy, Eigen::Ref<MatrixXd> dv) {
-    if (k_.dynamics_jacobian(y, yd, a_.data(), u_.data(), p_.data(), Ky_.data(), Kv_.data()) != 0)
+  // The LU of the equilibrated S M S, S = diag(|M_ii|)^(-1/2) (its pivots do not depend on the
+  // units: kg against kg m²). False when M is singular to working precision: the pivots' ratio
+  // bounds the reciprocal condition number from above (Eigen's rcond() estimate is 1 for an
+  // exactly singular matrix), and where it is below 1e-8 the LU's condition estimate decides
+  // (a few solves more, so not at every evaluation of a well-conditioned M).
+  bool factor_mass() {
+    for (Index i = 0; i < n_; ++i) {
+      const double d = std::abs(M_(i, i));
+      scale_[i] = d > 0 && std::isfinite(d) ? 1 / std::sqrt(d) : 1.0;
+    }
+    for (Index j = 0; j < n_; ++j)
+      for (Index i = 0; i < n_; ++i) scaled_(i, j) = scale_[i] * M_(i, j) * scale_[j];
+    lu_.compute(scaled_);
+    if (n_ == 0) return true;
+    double smallest = kInfinity, largest = 0;
+    for (Index i = 0; i < n_; ++i) {
+      const double d = std::abs(lu_.matrixLU()(i, i));
+      smallest = std::min(smallest, d), largest = std::max(largest, d);
+    }
+    const double singular = static_cast<double>(n_) * std::numeric_limits<double>::epsilon();
+    rcond_ = smallest / largest;
+    if (rcond_ > singular && rcond_ < 1e-8) rcond_ = std::min(rcond_, lu_.rcond());
+    return rcond_ > singular;
+  }
+  // M, K_y(y, ẏ, ÿ) and K_v after evaluate() at the same state: the Jacobian's parts
+  // (second_order_newton.hpp).
+  bool jacobian(double t, const double* y, const double* yd, detail::SecondOrderMatrix& J) {
+    if (k_.dynamics_jacobian(y, yd, a_.data(), u_.data(), p_.data(), J.Ky.data(), J.Kv.data()) != 0)
       return fail(t, Failure::non_finite);
-    Ky_ = -Ky_;
-    Kv_ = -Kv_;
-    dy = lu_.solve(Ky_);
-    dv = lu_.solve(Kv_);
-    return dy.allFinite() && dv.allFinite() ? true : fail(t, Failure::non_finite);
+    J.M = M_;
+    J.c = 1;
+    J.d = 0;
+    return J.Ky.allFinite() && J.Kv.allFinite() ? true : fail(t, Failure::non_finite);
   }
   const VectorXd& accelerations() const { return a_; }
   const std::vector<double>& parameters() const { return p_; }
@@ -234,8 +251,8 @@ class Equations {
   Index n_;
   const SimulationOptions& options_;
   MatrixXd M_;
-  VectorXd r_, u_, a_;
-  MatrixXd Ky_, Kv_;
+  VectorXd r_, u_, a_, scale_;
+  MatrixXd scaled_;
   std::vector<double> anchor_, tree_;
   Eigen::PartialPivLU<MatrixXd> lu_;
   double rcond_ = 0, segment_start_ = 0;
@@ -259,7 +276,8 @@ int rhs_function(realtype t, N_Vector x, N_Vector xp, void* data) noexcept {
   }
 }
 
-// ∂x'/∂x = [0, I; −M⁻¹ K_y, −M⁻¹ K_v], with K_y at ÿ = x'[n:] (the right-hand side CVODE passes).
+// ∂x'/∂x = [0, I; −M⁻¹ K_y, −M⁻¹ K_v] as its parts M, K_y, K_v (second_order_newton.hpp), with
+// K_y at the accelerations of the state (evaluated again for M and ÿ there).
 int jacobian_function(realtype t, N_Vector x, N_Vector, SUNMatrix J, void* data, N_Vector, N_Vector,
                       N_Vector) noexcept {
   auto& eq = *static_cast<Equations*>(data);
@@ -267,10 +285,7 @@ int jacobian_function(realtype t, N_Vector x, N_Vector, SUNMatrix J, void* data,
     const Index n = eq.size();
     const double* xs = N_VGetArrayPointer(x);
     if (!eq.evaluate(t, xs, xs + n)) return 1;
-    Eigen::Map<MatrixXd> A(SM_DATA_D(J), 2 * n, 2 * n);
-    A.setZero();
-    A.topRightCorner(n, n).diagonal().setOnes();
-    return eq.jacobian(t, xs, xs + n, A.bottomLeftCorner(n, n), A.bottomRightCorner(n, n)) ? 0 : 1;
+    return eq.jacobian(t, xs, xs + n, detail::parts(J)) ? 0 : 1;
   } catch (...) {
     eq.failure = Equations::Failure::exception;
     eq.failed_time = t;
@@ -576,7 +591,7 @@ SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op,
   if (eq.follows_loops() && !eq.close_initial(op.y0, y))
     throw SimulationError("simulate: the kinematic loops cannot be closed at the initial state (from the operating "
                           "point's configuration by continuation)", 0.0);
-  Cvode cv(2 * n, o.method);
+  Cvode cv(2 * n, o.method, eq.analytic_jacobian());
   std::string message;
   double* x = N_VGetArrayPointer(cv.x);
   Eigen::Map<VectorXd>(x, n) = y;
