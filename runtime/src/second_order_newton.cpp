@@ -62,7 +62,7 @@ int matrix_space(SUNMatrix A, long* real_words, long* integer_words) {
 struct Solver {
   Eigen::PartialPivLU<MatrixXd> lu;
   MatrixXd R;
-  VectorXd rhs, dv;
+  VectorXd rhs, dv, scale;
   double c = 0, d = 1;
   sunindextype last_flag = 0;
 };
@@ -73,15 +73,23 @@ SUNLinearSolver_Type solver_type(SUNLinearSolver) { return SUNLINEARSOLVER_DIREC
 SUNLinearSolver_ID solver_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
 int solver_initialize(SUNLinearSolver) { return SUNLS_SUCCESS; }
 
-// R = d·M − c·K_v + (c²/d)·K_y, factored; singular (a pivot below 2^-52·n of the largest):
-// recoverable, CVODE retries with a smaller step.
+// R = d·M − c·K_v + (c²/d)·K_y, equilibrated as M is (S R S, S = diag(|M_ii|)^(-1/2): for small
+// γ, R is M in its units, kg against kg m²) and factored; singular (a pivot below 2^-52·n of the
+// largest): recoverable, CVODE retries with a smaller step.
 int solver_setup(SUNLinearSolver S, SUNMatrix A) noexcept {
   Solver& s = solver(S);
   const SecondOrderMatrix& a = content(A);
   if (a.d == 0) return s.last_flag = SUNLS_ILL_INPUT;
   s.c = a.c;
   s.d = a.d;
+  const Index n = a.M.rows();
+  for (Index i = 0; i < n; ++i) {
+    const double m = std::abs(a.M(i, i));
+    s.scale[i] = m > 0 && std::isfinite(m) ? 1 / std::sqrt(m) : 1.0;
+  }
   s.R = a.d * a.M - a.c * a.Kv + (a.c * a.c / a.d) * a.Ky;
+  for (Index j = 0; j < n; ++j)
+    for (Index i = 0; i < n; ++i) s.R(i, j) *= s.scale[i] * s.scale[j];
   s.lu.compute(s.R);
   const auto pivots = s.lu.matrixLU().diagonal().cwiseAbs();
   const double largest = pivots.size() ? pivots.maxCoeff() : 1.0;
@@ -97,7 +105,9 @@ int solver_solve(SUNLinearSolver S, SUNMatrix A, N_Vector x, N_Vector b, double)
   const Map<const VectorXd> r1(N_VGetArrayPointer(b), n), r2(N_VGetArrayPointer(b) + n, n);
   s.rhs.noalias() = a.M * r2;
   s.rhs.noalias() += (s.c / s.d) * a.Ky * r1;
+  s.rhs.array() *= s.scale.array();  // Δv = S (S R S)⁻¹ S rhs
   s.dv.noalias() = s.lu.solve(s.rhs);
+  s.dv.array() *= s.scale.array();
   Map<VectorXd> dy(N_VGetArrayPointer(x), n), dv(N_VGetArrayPointer(x) + n, n);
   dy = (r1 - s.c * s.dv) / s.d;  // x and b may be the same vector: r1 is read before dv is written
   dv = s.dv;
@@ -165,6 +175,7 @@ SUNLinearSolver new_second_order_solver(Index n, SUNContext context) {
     s->lu = Eigen::PartialPivLU<MatrixXd>(n);
     s->rhs.setZero(n);
     s->dv.setZero(n);
+    s->scale.setOnes(n);
   } catch (const std::bad_alloc&) {
     delete s;
     SUNLinSolFreeEmpty(S);

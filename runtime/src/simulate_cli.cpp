@@ -194,8 +194,9 @@ int run_simulate(const ModelKernels& k, const SimulateOptions& o, std::ostream& 
     progress_shown = true;
   };
   if (o.method == "bdf" && k.mass_matrix && k.residual && !k.dynamics_jacobian && !o.difference_quotients)
-    err << "note: the kernels have no dynamics_jacobian (generate with --dynamics): iteration matrices from "
-           "difference quotients\n";
+    err << "note: the kernels have no dynamics_jacobian ("
+        << (k.n_constraints > 0 ? "not emitted for closed loops" : "generate with --dynamics")
+        << "): iteration matrices from difference quotients\n";
   SimulationResult r;
   try {
     r = simulate(model, model.operating_point(), s);

@@ -162,8 +162,10 @@ class Equations {
   void start_segment(double t) { segment_start_ = t; }
   // M, k − q and ÿ at (y, ẏ, u(t)); false (with the reason kept) when a kernel fails or M is
   // singular there.
-  bool evaluate(double t, const double* y, const double* yd) {
-    inputs(t);
+  // `signal_values`: with the signals' own values at t (a sample's, which it stores), not those
+  // just after a restart at t.
+  bool evaluate(double t, const double* y, const double* yd, bool signal_values = false) {
+    if (signal_values) inputs_at(t); else inputs(t);
     int s = 0;
     if (follows_loops()) {
       const double* tree = closed(y);
@@ -228,7 +230,9 @@ class Equations {
       case Failure::non_finite:
         return "the kernels returned non-finite values (the state or a parameter left the model's range)";
       case Failure::loops:
-        return "the kinematic loops could not be closed (a dead point, or far from the operating point)";
+        return follows_loops() ? "the kinematic loops could not be closed (a dead point of the independent coordinates, "
+                                 "or a step too large to close them from the last one)"
+                               : "the kinematic loops could not be closed (a dead point, or far from the operating point)";
       case Failure::singular_mass:
         return "the mass matrix is singular (reciprocal condition number " + short_number(rcond_) +
                "): no unique accelerations";
@@ -329,8 +333,8 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   if (!k.mass_matrix || !k.residual)
     throw Error("simulate: model '" + std::string(k.model) + "' (scene '" + k.scene +
                 "') has no second-order kernels mass_matrix and residual: " +
-                (std::string(k.scene) == "full" ? "its kernels are the descriptor form of a model with rolling constraints"
-                                                : "the scene does not ask for simulate (add it to its analyses)"));
+                (k.descriptor ? "its kernels are the descriptor form of a model with rolling constraints"
+                              : "the scene does not ask for simulate (add it to its analyses)"));
   auto positive = [](double v, const char* what) {
     if (!(std::isfinite(v) && v > 0))
       throw Error(std::string("simulate: ") + what + " must be a finite number > 0, got " + std::to_string(v));
@@ -447,7 +451,9 @@ void record(SimulationResult& r, Index j, double t, const double* x, Equations& 
   if (r.z.rows() == 0) return;
   int status = 0;
   if (k.outputs_general) {
-    if (!eq.evaluate(t, x, x + n)) throw SimulationError("simulate: " + eq.reason() + " " + at_time(t), t);
+    // The accelerations under the inputs the sample stores (before a jump at t, whether or not
+    // the integrator has restarted there yet).
+    if (!eq.evaluate(t, x, x + n, true)) throw SimulationError("simulate: " + eq.reason() + " " + at_time(t), t);
     const VectorXd u = r.u.col(j);
     const double* ydd = eq.accelerations().data();
     if (tree && !(tree = eq.closed(x)))  // again: evaluate() closed the loops in the same buffer

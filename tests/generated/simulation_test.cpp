@@ -575,6 +575,45 @@ TEST(Simulation, FourBarSwingsWithItsLoopClosed) {
   EXPECT_GT(r.z.rows(), 0);  // the joint loads through outputs_general
 }
 
+// Outputs on ÿ and u (the four-bar's joint loads) at every sample are those of the inputs the
+// sample stores, also at an input step that falls on a sample (stored: the value before the
+// jump, whichever side of the restart the sample is taken on): recomputed here from the kernels,
+// ÿ = −M⁻¹(k − q) at the stored state and input, to 1e-9 of the largest load (the same state;
+// only the solve's rounding differs). Before the fix, a sample taken after the restart had ÿ of
+// the new input with u of the old one, off by the step's whole effect.
+TEST(Simulation, OutputsAtAStepUseTheStoredInputs) {
+  GeneratedModel model(four_bar::kernels());
+  const mbsgen::ModelKernels& k = model.kernels();
+  const std::vector<double>& p = model.parameters();
+  // Loose tolerances and dense samples: an integrator step that ends at the step input then
+  // also passes the sample before it, which is interpolated before the restart.
+  for (double step : {0.1, 0.02, 0.01, 0.005}) {
+    SimulationOptions o;
+    o.duration = 1;
+    o.step = step;
+    o.rtol = 1e-5;
+    o.atol = 1e-7;
+    o.inputs = {InputSignal::step(0.05, 0.5)};
+    const SimulationResult r = run(model, o);
+    ASSERT_EQ(r.restarts, 1);
+    ASSERT_GT(r.z.rows(), 0);
+    double worst = 0, largest = 0;
+    for (Eigen::Index j = 0; j < r.t.size(); ++j) {
+      double y = r.y(0, j), yd = r.yd(0, j), u = r.u(0, j), M = 0, res = 0;
+      ASSERT_EQ(k.dynamics(&y, &yd, &u, p.data(), &M, &res), 0);
+      double ydd = -res / M;
+      Eigen::VectorXd z(k.n_outputs);
+      ASSERT_EQ(k.outputs_general(&y, &yd, &ydd, &u, p.data(), z.data()), 0);
+      worst = std::max(worst, (z - r.z.col(j)).cwiseAbs().maxCoeff());
+      largest = std::max(largest, z.cwiseAbs().maxCoeff());
+      if (std::abs(r.t[j] - 0.5) < 1e-12) {
+        EXPECT_EQ(u, 0.0) << "the sample at the step stores the value before it";
+      }
+    }
+    EXPECT_LE(worst, 1e-9 * largest) << "output step " << step;
+  }
+}
+
 // The crank of this crank-rocker (Grashof: l1 + a <= l2 + l3) turns fully. The loops are closed
 // from the last step's configuration (assemble_from), so the motion keeps its branch over many
 // turns; started half a turn from the operating point, the closure reaches the start by

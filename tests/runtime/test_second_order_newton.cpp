@@ -55,6 +55,40 @@ TEST(SecondOrderNewton, EqualsTheDenseSolve) {
     ASSERT_EQ(SUNLinSolSolve(S, A, b, b, 0.0), SUNLS_SUCCESS);
     EXPECT_EQ((Eigen::Map<const VectorXd>(N_VGetArrayPointer(b), 2 * n) - got).norm(), 0.0);
   }
+  // Units that spread M's diagonal over 18 decades (kg m² of a 0.1 mm part beside a tonne): the
+  // reduced matrix is equilibrated as M is, so it is not taken for singular (unscaled, its pivots
+  // span 1e-18 and setup failed), and the solution
+  // satisfies both block rows, d·Δy + c·Δv = r₁ and −c·K_y Δy + (d·M − c·K_v) Δv = M r₂, each
+  // scaled by S = diag(M)^(-1/2), to 1e-12 of the largest term.
+  {
+    VectorXd m(n);
+    m << 1e-10, 1e8, 1.0, 3e-4, 2e2, 5e-7;
+    const VectorXd h = m.cwiseSqrt();
+    // Nearly decoupled (weak coupling leaves the tiny pivots where they are; strong coupling
+    // would make the unscaled LU swap rows and hide the spread).
+    const MatrixXd X = 1e-12 * MatrixXd::Random(n, n);
+    const MatrixXd Ms = m.asDiagonal();
+    const MatrixXd Kys = 1e4 * (h.asDiagonal() * X * h.asDiagonal()), Kvs = 10 * (h.asDiagonal() * X.transpose() * h.asDiagonal());
+    parts(J).M = Ms, parts(J).Ky = Kys, parts(J).Kv = Kvs, parts(J).c = 1, parts(J).d = 0;
+    const double gamma = 1e-3;
+    ASSERT_EQ(SUNMatCopy(J, A), 0);
+    ASSERT_EQ(SUNMatScaleAddI(-gamma, A), 0);
+    ASSERT_EQ(SUNLinSolSetup(S, A), SUNLS_SUCCESS);
+    VectorXd rhs(2 * n);
+    rhs << VectorXd::Random(n), VectorXd::Random(n).cwiseProduct(h.cwiseInverse());
+    Eigen::Map<VectorXd>(N_VGetArrayPointer(b), 2 * n) = rhs;
+    ASSERT_EQ(SUNLinSolSolve(S, A, x, b, 0.0), SUNLS_SUCCESS);
+    const VectorXd dy = Eigen::Map<const VectorXd>(N_VGetArrayPointer(x), n);
+    const VectorXd dv = Eigen::Map<const VectorXd>(N_VGetArrayPointer(x) + n, n);
+    const double c = -gamma;
+    EXPECT_LE((dy + c * dv - rhs.head(n)).cwiseAbs().maxCoeff(),
+              1e-12 * (rhs.head(n).cwiseAbs().maxCoeff() + std::abs(c) * dv.cwiseAbs().maxCoeff()));
+    const VectorXd s = h.cwiseInverse();
+    const VectorXd second = s.asDiagonal() * (-c * Kys * dy + (Ms - c * Kvs) * dv - Ms * rhs.tail(n));
+    const double size = (s.asDiagonal() * (Ms * rhs.tail(n))).cwiseAbs().maxCoeff() +
+                        (s.asDiagonal() * (Ms * dv)).cwiseAbs().maxCoeff();
+    EXPECT_LE(second.cwiseAbs().maxCoeff(), 1e-12 * size);
+  }
   // M + γK_v + γ²K_y singular: a recoverable failure (CVODE retries with a smaller step).
   parts(J).M = MatrixXd::Identity(n, n), parts(J).Kv.setZero(), parts(J).Ky = -MatrixXd::Identity(n, n);
   ASSERT_EQ(SUNMatCopy(J, A), 0);
