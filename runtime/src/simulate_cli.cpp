@@ -35,6 +35,10 @@ SimulationOptions simulation_options(const GeneratedModel& model, const Simulate
     const auto [name, text] = assignment(a, "--initial");
     s.initial.emplace_back(name, finite_number(text, "--initial '" + a + "'"));
   }
+  for (const std::string& a : o.atol_of) {
+    const auto [name, text] = assignment(a, "--atol-of");
+    s.atol_of.emplace_back(name, finite_number(text, "--atol-of '" + a + "'"));
+  }
   if (!o.inputs.empty()) s.inputs.resize(static_cast<std::size_t>(model.kernels().n_inputs));
   for (const std::string& a : o.inputs) {
     const auto [name, spec] = assignment(a, "--input");
@@ -161,6 +165,8 @@ CLI::App* add_simulate(CLI::App& app, SimulateOptions& o) {
                                      "NAME=table:FILE.csv (t,value lines); repeatable (default: 0)");
   s->add_option("--rtol", o.rtol, "relative tolerance")->check(CLI::PositiveNumber);
   s->add_option("--atol", o.atol, "absolute tolerance")->check(CLI::PositiveNumber);
+  s->add_option("--atol-of", o.atol_of, "the absolute tolerance of one coordinate or rate, NAME=VALUE or "
+                                        "NAME_dot=VALUE, in its units (states of different sizes); repeatable");
   s->add_option("--method", o.method, "bdf (stiff models; the default) or adams (non-stiff motion: fewer, more "
                                      "accurate steps)")->check(CLI::IsMember({"bdf", "adams"}));
   s->add_option("--format", o.format, "output format")->check(CLI::IsMember({"csv", "json"}));

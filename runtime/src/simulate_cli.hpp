@@ -13,7 +13,7 @@
 namespace mbsgen::cli {
 
 struct SimulateOptions {
-  std::vector<std::string> set, initial, inputs, show;
+  std::vector<std::string> set, initial, inputs, show, atol_of;
   double duration = 0, step = 0, rtol = 1e-8, atol = 1e-10;
   std::string format = "csv", plot, method = "bdf";
   bool difference_quotients = false, statistics = false;

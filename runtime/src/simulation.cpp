@@ -328,6 +328,30 @@ void initial_state(const GeneratedModel& model, const OperatingPoint& op, const 
   }
 }
 
+// The absolute tolerance of each state (coordinates, then rates): atol, or atol_of by name.
+VectorXd absolute_tolerances(const ModelKernels& k, const SimulationOptions& o) {
+  const Index n = k.n_coordinates;
+  VectorXd atol = VectorXd::Constant(2 * n, o.atol);
+  const std::vector<std::string> names = name_list(k.coordinate_names, k.n_coordinates);
+  for (const auto& [name, value] : o.atol_of) {
+    if (!(std::isfinite(value) && value > 0))
+      throw Error("simulate: the absolute tolerance of '" + name + "' must be a finite number > 0, got " +
+                  std::to_string(value));
+    bool found = false;
+    for (Index i = 0; i < n && !found; ++i) {
+      const std::string& c = names[static_cast<std::size_t>(i)];
+      if (name == c) atol[i] = value, found = true;
+      if (name == c + "_dot") atol[n + i] = value, found = true;
+    }
+    if (!found) {
+      std::string known;
+      for (const auto& c : names) known += (known.empty() ? "" : ", ") + c + ", " + c + "_dot";
+      throw NameError("simulate: no coordinate or rate '" + name + "' for an absolute tolerance; known: " + known);
+    }
+  }
+  return atol;
+}
+
 void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   const ModelKernels& k = model.kernels();
   if (!k.mass_matrix || !k.residual)
@@ -343,6 +367,7 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   positive(o.step, "the output step");
   positive(o.rtol, "rtol");
   positive(o.atol, "atol");
+  absolute_tolerances(k, o);  // the names and values of atol_of
   const double values = (o.duration / o.step + 1) * (2.0 * k.n_coordinates + k.n_inputs + k.n_outputs);
   if (values > kMaxValues)
     throw Error("simulate: " + short_number(o.duration / o.step + 1) + " samples of " +
@@ -413,7 +438,16 @@ void configure(Cvode& cv, Equations& eq, const SimulationOptions& o, std::string
     if (flag != 0) throw Error(std::string("simulate: ") + what + " failed (" + std::to_string(flag) + ")");
   };
   check(CVodeInit(cv.mem, rhs_function, 0.0, cv.x), "CVodeInit");
-  check(CVodeSStolerances(cv.mem, o.rtol, o.atol), "CVodeSStolerances");
+  if (o.atol_of.empty()) {
+    check(CVodeSStolerances(cv.mem, o.rtol, o.atol), "CVodeSStolerances");
+  } else {  // CVODE copies the vector
+    VectorXd atol = absolute_tolerances(eq.kernels(), o);
+    N_Vector v = N_VMake_Serial(atol.size(), atol.data(), cv.context);
+    if (!v) throw Error("simulate: out of memory for the tolerances");
+    const int flag = CVodeSVtolerances(cv.mem, o.rtol, v);
+    N_VDestroy(v);
+    check(flag, "CVodeSVtolerances");
+  }
   check(CVodeSetUserData(cv.mem, &eq), "CVodeSetUserData");
   check(CVodeSetErrHandlerFn(cv.mem, error_handler, &message), "CVodeSetErrHandlerFn");
   if (cv.fixed_point) {

@@ -83,6 +83,10 @@ struct SimulationOptions {
   double duration = 1;  ///< s, > 0
   double step = 1e-2;   ///< output sampling, s, > 0; the last sample is at `duration`
   double rtol = 1e-8, atol = 1e-10;
+  /// Absolute tolerances of single coordinates (`phi`) or rates (`phi_dot`) instead of `atol`,
+  /// in their own units: for states of different sizes (metres and radians, or nanometres beside
+  /// a rotation), atol of about rtol × the size each reaches.
+  std::vector<std::pair<std::string, double>> atol_of;
   /// Initial coordinates and rates by name (`phi`, `phi_dot`); the others start at the
   /// operating point's values.
   std::vector<std::pair<std::string, double>> initial;
