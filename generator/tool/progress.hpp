@@ -4,6 +4,7 @@
 // (pipes, files, ctest), so that captured output and messages stay as they are.
 #pragma once
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -22,7 +23,15 @@ class Progress {
 
   /// `command`: "check", "info", "generate" or "run", shown in the line.
   explicit Progress(std::string command) : command_(std::move(command)) {
-    if (isatty(STDERR_FILENO) == 1) thread_ = std::thread([this] { run(); });
+    if (isatty(STDERR_FILENO) == 1)
+      thread_ = std::thread([this] {
+        // Termination signals go to the main thread, whose waits they interrupt (run.cpp).
+        sigset_t signals;
+        sigemptyset(&signals);
+        for (int s : {SIGTERM, SIGHUP, SIGINT}) sigaddset(&signals, s);
+        pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+        run();
+      });
   }
   ~Progress() { stop(); }
   Progress(const Progress&) = delete;

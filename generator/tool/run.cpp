@@ -16,6 +16,7 @@
 #include "mbsgen_build_config.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -116,7 +117,8 @@ Toolchain toolchain() {
 }
 
 // Starts argv[0] (searched on PATH when it has no '/') with argv, its standard output and error
-// going to log (created exclusively); returns its process id.
+// going to log (created exclusively); returns its process id. The child leads a process group of
+// its own, so that stopping it stops what it started (the compiler driver's cc1plus).
 pid_t spawn_program(const std::vector<std::string>& args, const fs::path& log) {
   const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) throw std::runtime_error("cannot create " + log.string() + ": " + std::strerror(errno));
@@ -127,8 +129,13 @@ pid_t spawn_program(const std::vector<std::string>& args, const fs::path& log) {
   std::vector<char*> argv;
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attributes, 0);
   pid_t pid = 0;
-  const int error = ::posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  const int error = ::posix_spawnp(&pid, argv[0], &actions, &attributes, argv.data(), environ);
+  posix_spawnattr_destroy(&attributes);
   posix_spawn_file_actions_destroy(&actions);
   ::close(fd);
   if (error != 0) throw std::runtime_error("cannot run " + args[0] + ": " + std::strerror(error));
@@ -137,6 +144,51 @@ pid_t spawn_program(const std::vector<std::string>& args, const fs::path& log) {
 
 // The exit status of a process that ended with status; -1 when it was killed.
 int exit_status(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
+
+// A termination signal (SIGTERM, SIGHUP, SIGINT) received while the solver is built: the
+// compilers are stopped and the private build directory removed (build_solver) instead of being
+// left running and half-written. Without SA_RESTART, waitpid returns EINTR when it arrives.
+volatile sig_atomic_t g_termination = 0;
+extern "C" void on_termination(int signal) { g_termination = signal; }
+
+class TerminationGuard {
+ public:
+  TerminationGuard() {
+    struct sigaction action {};
+    action.sa_handler = on_termination;
+    sigemptyset(&action.sa_mask);
+    for (std::size_t i = 0; i < 3; ++i) ::sigaction(kSignals[i], &action, &previous_[i]);
+  }
+  ~TerminationGuard() {
+    for (std::size_t i = 0; i < 3; ++i) ::sigaction(kSignals[i], &previous_[i], nullptr);
+  }
+  TerminationGuard(const TerminationGuard&) = delete;
+  TerminationGuard& operator=(const TerminationGuard&) = delete;
+
+ private:
+  static constexpr int kSignals[3] = {SIGTERM, SIGHUP, SIGINT};
+  struct sigaction previous_[3] {};
+};
+
+// Thrown once the children are stopped; the exit status is 128 + the signal (run_main).
+struct Terminated : std::runtime_error {
+  int signal;
+  explicit Terminated(int s) : std::runtime_error(std::string("stopped by signal ") + std::to_string(s)), signal(s) {}
+};
+
+// After a termination signal: stops the running children and their process groups, waits for
+// them, throws Terminated.
+void stop_if_terminated(const std::vector<pid_t>& running) {
+  const int signal = g_termination;
+  if (signal == 0) return;
+  for (pid_t pid : running) ::kill(-pid, SIGTERM);
+  for (pid_t pid : running) {
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+  }
+  throw Terminated(signal);
+}
 
 // One compiler run and where its messages go.
 struct Job {
@@ -153,7 +205,13 @@ std::vector<std::size_t> run_jobs(const std::vector<Job>& jobs, std::size_t para
   std::size_t next = 0, done = 0;
   auto report = [&] { progress.detail(std::to_string(done) + " of " + std::to_string(jobs.size()) + " files"); };
   report();
+  auto pids = [&] {
+    std::vector<pid_t> p;
+    for (const auto& r : running) p.push_back(r.first);
+    return p;
+  };
   while (next < jobs.size() || !running.empty()) {
+    stop_if_terminated(pids());
     while (failed.empty() && next < jobs.size() && running.size() < parallel) {
       running.push_back({spawn_program(jobs[next].args, jobs[next].log), next});
       ++next;
@@ -272,9 +330,12 @@ bool compile_solver(const Toolchain& tc, const fs::path& work, const GeneratedCo
     link.insert(link.end(), tc.libraries.begin(), tc.libraries.end());
     const fs::path log = work / "link.log";
     int status = 0;
+    stop_if_terminated({});
     const pid_t pid = spawn_program(link, log);
-    while (::waitpid(pid, &status, 0) < 0)
+    while (::waitpid(pid, &status, 0) < 0) {
       if (errno != EINTR) return false;
+      stop_if_terminated({pid});
+    }
     if (exit_status(status) == 0) return true;
     progress.stop();
     std::cerr << "mbsgen run: error: linking the solver failed; see " << log.string() << "\n";
@@ -382,9 +443,13 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
       fs::remove_all(dir, ec);
     }
     const auto t0 = std::chrono::steady_clock::now();
-    {
+    try {
+      TerminationGuard guard;
       Progress progress("run");  // on a terminal, after 2 s: the stage, and files compiled
       if (!build_solver(model_file, scene, dynamics, text, tc, dir, progress)) return 1;
+    } catch (const Terminated& t) {  // the children stopped, the build directory removed
+      std::cerr << "mbsgen run: " << t.what() << "; the solver was not built\n";
+      return 128 + t.signal;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (::isatty(STDERR_FILENO))

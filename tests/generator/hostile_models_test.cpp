@@ -25,12 +25,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <thread>
 
 namespace {
 
@@ -630,6 +633,62 @@ TEST(MbsgenCli, RunRebuildsADamagedCacheEntry) {
   EXPECT_EQ(r.status, 0);
   EXPECT_EQ(r.output.find("damaged"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir / "canary"));
+  fs::remove_all(dir);
+}
+
+// The processes whose command line names `path` (the compilers a build in a cache runs).
+std::vector<pid_t> processes_naming(const std::string& path) {
+  std::vector<pid_t> found;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/proc", ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::string cmdline = slurp(e.path() / "cmdline");
+    std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+    if (cmdline.find(path) != std::string::npos) found.push_back(static_cast<pid_t>(std::stol(name)));
+  }
+  return found;
+}
+
+// `mbsgen run` stopped by SIGTERM while it compiles (the middle ear: seconds of compiling) stops
+// its compilers, the drivers' cc1plus included, and leaves no half-built directory in the cache;
+// it exits with 128 + 15. They used to run on, orphaned, writing into the cache.
+TEST(MbsgenCli, RunStoppedStopsItsCompilers) {
+  const fs::path dir = temporary_directory();
+  const fs::path cache = dir / "cache";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) ::_exit(126);
+    FILE* f = std::freopen((dir / "output").c_str(), "w", stdout);
+    if (!f || ::dup2(STDOUT_FILENO, STDERR_FILENO) < 0) ::_exit(126);
+    ::setenv("MBSGEN_CACHE_DIR", cache.c_str(), 1);
+    const std::string model = std::string(MBSGEN_SOURCE_DIR) + "/models/middle_ear/middle_ear.yaml";
+    ::execl(MBSGEN_TOOL, MBSGEN_TOOL, "run", model.c_str(), "--", "modes", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ASSERT_GT(pid, 0);
+  bool compiling = false;
+  int status = 0;
+  for (int i = 0; i < 3000 && !compiling; ++i) {  // at most 300 s (a sanitizer build derives slowly)
+    if (::waitpid(pid, &status, WNOHANG) == pid) break;
+    compiling = !processes_naming(cache.string()).empty();
+    if (!compiling) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_TRUE(compiling) << "no compiler seen; " << slurp(dir / "output");
+  ::kill(pid, SIGTERM);
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << slurp(dir / "output");
+  EXPECT_NE(slurp(dir / "output").find("mbsgen run: stopped by signal 15; the solver was not built"),
+            std::string::npos);
+  std::vector<pid_t> left = processes_naming(cache.string());
+  for (int i = 0; i < 100 && !left.empty(); ++i) {  // they end within moments of SIGTERM
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    left = processes_naming(cache.string());
+  }
+  EXPECT_TRUE(left.empty()) << left.size() << " compiler processes still running";
+  std::size_t entries = 0;
+  for (const auto& e : fs::directory_iterator(cache)) entries += e.path().empty() ? 0 : 1;
+  EXPECT_EQ(entries, 0u) << "a half-built directory was left in the cache";
   fs::remove_all(dir);
 }
 
