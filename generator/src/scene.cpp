@@ -237,9 +237,7 @@ Model apply_scene(const Model& model, const std::string& name) {
   sel.full = false;
   sel.analyses = scene->analyses;
   sel.frequency_range = scene->frequency_range;
-  auto asks = [&](Analysis a) {
-    return std::find(sel.analyses.begin(), sel.analyses.end(), a) != sel.analyses.end();
-  };
+  auto asks = [&](Analysis a) { return sel.asks(a); };
   sel.kernels.clear();
   for (const auto& k : SceneSelection::all_kernels()) {
     bool used = k == "operating_point";

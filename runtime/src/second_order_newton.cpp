@@ -82,19 +82,10 @@ int solver_setup(SUNLinearSolver S, SUNMatrix A) noexcept {
   if (a.d == 0) return s.last_flag = SUNLS_ILL_INPUT;
   s.c = a.c;
   s.d = a.d;
-  const Index n = a.M.rows();
-  for (Index i = 0; i < n; ++i) {
-    const double m = std::abs(a.M(i, i));
-    s.scale[i] = m > 0 && std::isfinite(m) ? 1 / std::sqrt(m) : 1.0;
-  }
   s.R = a.d * a.M - a.c * a.Kv + (a.c * a.c / a.d) * a.Ky;
-  for (Index j = 0; j < n; ++j)
-    for (Index i = 0; i < n; ++i) s.R(i, j) *= s.scale[i] * s.scale[j];
+  equilibrate(a.M, s.scale, s.R);
   s.lu.compute(s.R);
-  const auto pivots = s.lu.matrixLU().diagonal().cwiseAbs();
-  const double largest = pivots.size() ? pivots.maxCoeff() : 1.0;
-  const bool singular = pivots.size() && !(pivots.minCoeff() > static_cast<double>(pivots.size()) *
-                                                                     std::numeric_limits<double>::epsilon() * largest);
+  const bool singular = !(pivot_ratio(s.lu) > static_cast<double>(a.M.rows()) * std::numeric_limits<double>::epsilon());
   return s.last_flag = singular ? SUNLS_LUFACT_FAIL : SUNLS_SUCCESS;
 }
 
@@ -131,6 +122,22 @@ int solver_free(SUNLinearSolver S) {
 }
 
 }  // namespace
+
+void equilibrate(const MatrixXd& M, VectorXd& scale, MatrixXd& A) {
+  const Index n = M.rows();
+  for (Index i = 0; i < n; ++i) {
+    const double m = std::abs(M(i, i));
+    scale[i] = m > 0 && std::isfinite(m) ? 1 / std::sqrt(m) : 1.0;
+  }
+  for (Index j = 0; j < n; ++j)
+    for (Index i = 0; i < n; ++i) A(i, j) = scale[i] * A(i, j) * scale[j];
+}
+
+double pivot_ratio(const Eigen::PartialPivLU<MatrixXd>& lu) {
+  if (lu.rows() == 0) return 1.0;
+  const auto pivots = lu.matrixLU().diagonal().cwiseAbs();
+  return pivots.minCoeff() / pivots.maxCoeff();
+}
 
 SecondOrderMatrix& parts(SUNMatrix A) { return content(A); }
 

@@ -14,10 +14,19 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <sundials/sundials_linearsolver.h>
 #include <sundials/sundials_matrix.h>
 
 namespace mbsgen::detail {
+
+/// Equilibration by the mass matrix: scale = diag(|M_ii|)^(-1/2) (1 where M_ii is 0 or not
+/// finite), and A := S A S in place (its pivots then do not depend on the units: kg against
+/// kg m²). For M's LU per evaluation (simulation.cpp) and for the reduced Newton matrix.
+void equilibrate(const Eigen::MatrixXd& M, Eigen::VectorXd& scale, Eigen::MatrixXd& A);
+/// The smallest over the largest |pivot| of an LU (1 for an empty matrix): an upper bound of the
+/// reciprocal condition number (NaN, never above n·ε, for a zero matrix).
+double pivot_ratio(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu);
 
 /// A = d·I + c·[0, I; −M⁻¹K_y, −M⁻¹K_v] (2n×2n), kept as its parts.
 struct SecondOrderMatrix {

@@ -191,21 +191,11 @@ class Equations {
   // exactly singular matrix), and where it is below 1e-8 the LU's condition estimate decides
   // (a few solves more, so not at every evaluation of a well-conditioned M).
   bool factor_mass() {
-    for (Index i = 0; i < n_; ++i) {
-      const double d = std::abs(M_(i, i));
-      scale_[i] = d > 0 && std::isfinite(d) ? 1 / std::sqrt(d) : 1.0;
-    }
-    for (Index j = 0; j < n_; ++j)
-      for (Index i = 0; i < n_; ++i) scaled_(i, j) = scale_[i] * M_(i, j) * scale_[j];
+    scaled_ = M_;
+    detail::equilibrate(M_, scale_, scaled_);
     lu_.compute(scaled_);
-    if (n_ == 0) return true;
-    double smallest = kInfinity, largest = 0;
-    for (Index i = 0; i < n_; ++i) {
-      const double d = std::abs(lu_.matrixLU()(i, i));
-      smallest = std::min(smallest, d), largest = std::max(largest, d);
-    }
     const double singular = static_cast<double>(n_) * std::numeric_limits<double>::epsilon();
-    rcond_ = smallest / largest;
+    rcond_ = detail::pivot_ratio(lu_);
     if (rcond_ > singular && rcond_ < 1e-8) rcond_ = std::min(rcond_, lu_.rcond());
     return rcond_ > singular;
   }
@@ -306,48 +296,40 @@ void error_handler(int, const char*, const char*, char* message, void* data) noe
 
 // ---------------------------------------------------------------------------------------------
 
+// The position of state `name` in x = (y, ẏ): a coordinate `phi` at its index, a rate `phi_dot`
+// at n + its index; NameError naming the known states otherwise (`what`: for the message).
+Index state_index(const ModelKernels& k, const std::string& name, const std::string& what) {
+  const std::vector<std::string> names = name_list(k.coordinate_names, k.n_coordinates);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (name == names[i]) return static_cast<Index>(i);
+    if (name == names[i] + "_dot") return k.n_coordinates + static_cast<Index>(i);
+  }
+  std::string known;
+  for (const auto& c : names) known += (known.empty() ? "" : ", ") + c + ", " + c + "_dot";
+  throw NameError("simulate: no coordinate or rate '" + name + "'" + what + "; known: " + known);
+}
+
 // The initial state: the operating point with options.initial applied.
 void initial_state(const GeneratedModel& model, const OperatingPoint& op, const SimulationOptions& o, VectorXd& y,
                    VectorXd& yd) {
   const ModelKernels& k = model.kernels();
   y = op.y0;
   yd = op.yd0;
-  const std::vector<std::string> names = name_list(k.coordinate_names, k.n_coordinates);
   for (const auto& [name, value] : o.initial) {
     if (!std::isfinite(value)) throw NonFiniteError("simulate: the initial value of '" + name + "' is not finite");
-    bool found = false;
-    for (std::size_t i = 0; i < names.size() && !found; ++i) {
-      if (name == names[i]) y[static_cast<Index>(i)] = value, found = true;
-      if (name == names[i] + "_dot") yd[static_cast<Index>(i)] = value, found = true;
-    }
-    if (!found) {
-      std::string known;
-      for (const auto& c : names) known += (known.empty() ? "" : ", ") + c + ", " + c + "_dot";
-      throw NameError("simulate: no coordinate or rate '" + name + "'; known: " + known);
-    }
+    const Index i = state_index(k, name, "");
+    (i < k.n_coordinates ? y[i] : yd[i - k.n_coordinates]) = value;
   }
 }
 
 // The absolute tolerance of each state (coordinates, then rates): atol, or atol_of by name.
 VectorXd absolute_tolerances(const ModelKernels& k, const SimulationOptions& o) {
-  const Index n = k.n_coordinates;
-  VectorXd atol = VectorXd::Constant(2 * n, o.atol);
-  const std::vector<std::string> names = name_list(k.coordinate_names, k.n_coordinates);
+  VectorXd atol = VectorXd::Constant(2 * k.n_coordinates, o.atol);
   for (const auto& [name, value] : o.atol_of) {
     if (!(std::isfinite(value) && value > 0))
       throw Error("simulate: the absolute tolerance of '" + name + "' must be a finite number > 0, got " +
                   std::to_string(value));
-    bool found = false;
-    for (Index i = 0; i < n && !found; ++i) {
-      const std::string& c = names[static_cast<std::size_t>(i)];
-      if (name == c) atol[i] = value, found = true;
-      if (name == c + "_dot") atol[n + i] = value, found = true;
-    }
-    if (!found) {
-      std::string known;
-      for (const auto& c : names) known += (known.empty() ? "" : ", ") + c + ", " + c + "_dot";
-      throw NameError("simulate: no coordinate or rate '" + name + "' for an absolute tolerance; known: " + known);
-    }
+    atol[state_index(k, name, " for an absolute tolerance")] = value;
   }
   return atol;
 }
