@@ -260,16 +260,32 @@ void add_force_elements(const Model& model, Equations& eq) {
   }
 }
 
+// A position or velocity output, absolute or relative to a marker R: directionᵀ S_Rᵀ (r − r_R)
+// and its rate directionᵀ S_Rᵀ (v − v_R − ω_R × (r − r_R)).
+ex motion_output(const Model& model, Equations& eq, const Output& o) {
+  Program& prog = eq.program;
+  Kinematics& kin = eq.kinematics;
+  const bool position = o.kind == OutputKind::position;
+  if (o.relative_to.empty())
+    return dot(o.direction, position ? kin.marker_position(model, prog, o.marker)
+                                     : kin.marker_velocity(model, prog, o.marker));
+  const Mat3 SR = kin.marker_frame(model, prog, o.relative_to);
+  const Vec3 d = define(prog, sub(kin.marker_position(model, prog, o.marker),
+                                  kin.marker_position(model, prog, o.relative_to)));
+  if (position) return dot(o.direction, mul_transposed(SR, d));
+  const Vec3 v = sub(sub(kin.marker_velocity(model, prog, o.marker), kin.marker_velocity(model, prog, o.relative_to)),
+                     cross(kin.marker_angular_velocity(model, o.relative_to), d));
+  return dot(o.direction, mul_transposed(SR, define(prog, v)));
+}
+
 void derive_outputs(const Model& model, Equations& eq) {
   Program& prog = eq.program;
   Kinematics& kin = eq.kinematics;
   for (const auto& o : model.outputs()) {
     switch (o.kind) {
       case OutputKind::position:
-        eq.outputs.push_back(dot(o.direction, kin.marker_position(model, prog, o.marker)));
-        break;
       case OutputKind::velocity:
-        eq.outputs.push_back(dot(o.direction, kin.marker_velocity(model, prog, o.marker)));
+        eq.outputs.push_back(motion_output(model, eq, o));
         break;
       case OutputKind::coordinate:
         eq.outputs.push_back(eq.y[static_cast<std::size_t>(model.coordinate_index(o.coordinate))]);
@@ -381,8 +397,13 @@ Equations derive(const Model& model, const DeriveOptions& options) {
   JointProbes probes;
   probes.bodies = probed_bodies(model);
   const Model probed = probes.bodies.empty() ? Model(model.name()) : with_joint_probes(model, probes.bodies);
-  Equations eq = derive_tree(probes.bodies.empty() ? model : probed, model, options);
+  // Motion inputs: the tree with them as coordinates, then split (prescribed_motion.hpp; models
+  // with motion inputs have no reaction outputs, Model::validate).
+  const bool motion = model.has_motion_inputs();
+  const Model moving = motion ? with_motion_coordinates(model) : Model(model.name());
+  Equations eq = derive_tree(motion ? moving : probes.bodies.empty() ? model : probed, model, options);
   if (!probes.bodies.empty()) strip_joint_probes(model, eq, probes);
+  if (motion) split_prescribed_motion(model, model.bodies().size(), eq);
   eq.model = &model;
   // Closed loops: the constraint stage, the reactions, and the equations in the independent
   // coordinates.

@@ -878,7 +878,8 @@ std::string manifest_json(const Model& model, const Equations& eq, const LinearE
   j << "],\n  \"inputs\": [";
   for (std::size_t i = 0; i < m; ++i)
     j << (i ? ", " : "") << "{\"name\": " << json_string(model.inputs()[i].name)
-      << ", \"unit\": " << json_string(model.inputs()[i].unit) << "}";
+      << ", \"unit\": " << json_string(model.inputs()[i].unit)
+      << ", \"kind\": \"" << (model.inputs()[i].motion ? "motion" : "force") << "\"}";
   j << "],\n  \"outputs\": [";
   for (std::size_t i = 0; i < r; ++i)
     j << (i ? ", " : "") << "{\"name\": " << json_string(model.outputs()[i].name)
@@ -1109,6 +1110,15 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
     kernels.push_back({"output_terms", "output rows C_a (r×f) and D (r×m) of z = C_y y + C_v yd + C_a ydd + D u, column-major",
                        {{"y0", y}, {"yd0", lin.at_rest ? std::vector<ex>{} : yd}, {"p", p}},
                        {{"Ca", column_major(lin.Ca, r, f), ""}, {"D", column_major(lin.Du, r, m), ""}}});
+  if (!lin.Ca.empty())
+    mark_zeros_at_operating_point(kernels.back(), {&lin.zeros.Ca, &lin.zeros.Du}, eq, lin);
+  if (!lin.B1.empty()) {
+    kernels.push_back({"excitation", "prescribed motion: B1, B2 (f×m) of h = B u + B1 u̇ + B2 ü and D1 (r×m) of z += D1 u̇, column-major",
+                       {{"y0", y}, {"yd0", lin.at_rest ? std::vector<ex>{} : yd}, {"p", p}},
+                       {{"B1", column_major(lin.B1, f, m), ""}, {"B2", column_major(lin.B2, f, m), ""},
+                        {"D1", column_major(lin.D1, r, m), ""}}});
+    mark_zeros_at_operating_point(kernels.back(), {&lin.zeros.B1, &lin.zeros.B2, &lin.zeros.D1}, eq, lin);
+  }
   kernels.push_back(bodies_kernel(eq, nb, y, p, f));
 
   if (loops)
@@ -1199,7 +1209,7 @@ std::string emitted_id(const Model& model, const EmitOptions& options) {
 std::string scene_kernel(const std::string& name) {
   if (name == "outputs_general") return "outputs";
   if (name == "dynamics" || name == "dynamics_jacobian") return "dynamics";
-  if (name == "output_terms" || name == "descriptor" || name == "reduced" || name == "reduced_parts") return "linear";
+  if (name == "output_terms" || name == "excitation" || name == "descriptor" || name == "reduced" || name == "reduced_parts") return "linear";
   return name;
 }
 

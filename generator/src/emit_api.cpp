@@ -121,7 +121,9 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     pu.push_back(p.unit);
     defaults.push_back(format_double(p.value));
   }
+  std::vector<std::string> kinds;
   for (const auto& i : model.inputs()) iu.push_back(i.unit);
+  for (const auto& i : model.inputs()) kinds.push_back(i.motion ? "motion" : "force");
   for (const auto& o : model.outputs()) ou.push_back(o.unit);
   auto kernel = [&](const std::string& name) {
     return has_kernel(code, name) ? "&" + id + "_" + name : std::string("nullptr");
@@ -133,6 +135,7 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     << id << ".hpp\"\n\nnamespace " << id << " {\n\nnamespace {\n";
   c << array("char* const", "coordinate_units", literals(cu)) << array("char* const", "parameter_units", literals(pu))
     << array("char* const", "input_units", literals(iu)) << array("char* const", "output_units", literals(ou));
+  if (model.has_motion_inputs()) c << array("char* const", "input_kinds", literals(kinds));
   c << "}  // namespace\n\n";
   c << "std::array<double, " << pm.size() << "> Parameters::values() const {\n  return {";
   for (std::size_t i = 0; i < pm.size(); ++i) c << (i ? ", " : "") << pm[i];
@@ -155,8 +158,8 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
       << lin.reduced.coordinates.size() << ", " << id << "_reduced_coordinate_names, " << kernel("reduced") << ", "
       << lin.reduced.named.size() << ", " << id << "_reduced_part_names, " << kernel("reduced_parts");
   // Time integration (EmitOptions::dynamics), the outputs at any state, and closed loops.
-  const bool loops = has_kernel(code, "assemble");
-  if (has_kernel(code, "dynamics") || has_kernel(code, "outputs_general") || loops) {
+  const bool loops = has_kernel(code, "assemble"), motion = model.has_motion_inputs();
+  if (has_kernel(code, "dynamics") || has_kernel(code, "outputs_general") || loops || motion) {
     if (!lin.descriptor) c << ",\n      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr";
     c << ",\n      " << kernel("dynamics") << ", " << kernel("dynamics_jacobian") << ", " << kernel("outputs_general");
   }
@@ -164,6 +167,10 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     c << ",\n      " << id << "_n_tree_coordinates, " << id << "_n_constraints, " << kernel("assemble") << ", "
       << kernel("constraints") << ",\n      " << kernel("assemble_from") << ", " << kernel("dynamics_full") << ", "
       << kernel("outputs_full") << ", " << kernel("outputs_general_full");
+  else if (motion)
+    c << ",\n      0, 0, nullptr, nullptr,\n      nullptr, nullptr, nullptr, nullptr";
+  // Prescribed motion: which inputs prescribe motion, and B1, B2, D1.
+  if (motion) c << ",\n      input_kinds, " << kernel("excitation");
   c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"

@@ -105,6 +105,43 @@ Structure structure_of(Equations& eq, const LinearEquations& lin, bool at_operat
 
 }  // namespace
 
+namespace {
+
+// Prescribed motion (prescribed_motion.hpp): the motion inputs' columns of B (B0), B1 and B2, and
+// of the outputs' D (D0) and D1, at the operating point (where u = u̇ = 0).
+void linearize_motion(Equations& eq, LinearEquations& lin, Program::Substitution& sub, ExMatrix& Ca,
+                      ExMatrix& Du) {
+  Program& prog = eq.program;
+  const PrescribedMotion& pm = eq.motion;
+  const std::size_t f = eq.y.size(), m = eq.u.size(), r = pm.outputs.size();
+  lin.B1.assign(f, std::vector<ex>(m, 0));
+  lin.B2.assign(f, std::vector<ex>(m, 0));
+  lin.D1.assign(r, std::vector<ex>(m, 0));
+  if (Du.empty()) {
+    Ca.assign(r, std::vector<ex>(f, 0));
+    Du.assign(r, std::vector<ex>(m, 0));
+  }
+  for (std::size_t i = 0; i < f; ++i) {
+    const ex ri = prog.define(pm.residual[i]);
+    for (std::size_t k = 0; k < pm.inputs.size(); ++k) {
+      const std::size_t j = pm.inputs[k];
+      lin.B[i][j] = -prog.diff_at(ri, eq.u[j], sub);
+      lin.B1[i][j] = -prog.diff_at(ri, pm.rates[k], sub);
+      lin.B2[i][j] = -prog.substitute(pm.M[i][k], sub);
+    }
+  }
+  for (std::size_t i = 0; i < r; ++i) {
+    const ex zi = prog.define(pm.outputs[i]);
+    for (std::size_t k = 0; k < pm.inputs.size(); ++k) {
+      const std::size_t j = pm.inputs[k];
+      Du[i][j] = prog.diff_at(zi, eq.u[j], sub);
+      lin.D1[i][j] = prog.diff_at(zi, pm.rates[k], sub);
+    }
+  }
+}
+
+}  // namespace
+
 // The tree's M, Q, K, B, C_y, C_v (and C_a, D) at the operating point, reduced to the
 // independent coordinates when the loops are closed (at rest).
 void linearize_tree(Equations& eq, LinearEquations& lin, std::size_t f) {  // f = n here
@@ -118,6 +155,7 @@ void linearize_tree(Equations& eq, LinearEquations& lin, std::size_t f) {  // f 
   GiNaC::exmap at_op;
   for (const auto& s : eq.u) at_op[s] = 0;
   for (const auto& s : eq.ydd) at_op[s] = 0;
+  for (const auto& s : eq.motion.rates) at_op[s] = 0;
   for (std::size_t k = 0; k < f; ++k)
     if (lin.at_rest || (!model.selection().full && lin.yd0[k].is_zero())) {
       at_op[eq.yd[k]] = 0;
@@ -159,6 +197,7 @@ void linearize_tree(Equations& eq, LinearEquations& lin, std::size_t f) {  // f 
     for (std::size_t j = 0; j < f; ++j) Ca[i][j] = prog.diff_at(zi, eq.ydd[j], sub);
     for (std::size_t j = 0; j < m; ++j) Du[i][j] = prog.diff_at(zi, eq.u[j], sub);
   }
+  if (eq.motion.active) linearize_motion(eq, lin, sub, Ca, Du);
   for (std::size_t k = 0; k < f; ++k) lin.coordinates.push_back(k);
   if (loops) {
     reduce_linear(eq, residual_at_rest, lin.M, lin.Q, lin.K, lin.B, lin.Cy, lin.Cv);

@@ -145,12 +145,28 @@ const Coordinate& Model::add_coordinate(const std::string& name, const std::stri
 }
 
 const GiNaC::symbol& Model::add_input(const std::string& name, const std::string& unit,
-                                      const SourceLocation& where) {
+                                      const SourceLocation& where, bool motion) {
   check_new_symbol(name, where);
-  inputs_.push_back({name, unit, where});
+  if (motion) check_new_symbol(name + "_dot", where);
+  Input input{name, unit, where, motion, GiNaC::symbol(name + "_dot")};
+  inputs_.push_back(input);
   input_symbols_.push_back(GiNaC::symbol(name));
   symtab_[name] = input_symbols_.back();
+  if (motion) symtab_[name + "_dot"] = inputs_.back().rate;
   return input_symbols_.back();
+}
+
+std::vector<GiNaC::symbol> Model::force_input_symbols() const {
+  std::vector<GiNaC::symbol> s;
+  for (std::size_t i = 0; i < inputs_.size(); ++i)
+    if (!inputs_[i].motion) s.push_back(input_symbols_[i]);
+  return s;
+}
+
+bool Model::has_motion_inputs() const {
+  for (const auto& i : inputs_)
+    if (i.motion) return true;
+  return false;
 }
 
 void Model::add_body(Body body) {
@@ -572,11 +588,38 @@ void Model::validate_velocity_constraints() const {
                                              "(rest or a steady motion), not at an equilibrium to be found");
 }
 
+// Prescribed motion (prescribed_motion.hpp) is derived for trees: a motion input in a model
+// with loop or velocity constraints, or with reaction outputs (whose joint probes would need the
+// prescribed accelerations), is refused rather than linearized wrongly.
+void Model::validate_motion_inputs() const {
+  for (const auto& i : inputs_) {
+    if (!i.motion) continue;
+    const std::string head = "motion input '" + i.name + "': prescribed motion ";
+    if (!constraints_.empty())
+      throw ModelError(i.where, head + "is derived for trees; this model has loop constraints (not supported yet)");
+    if (!velocity_constraints_.empty())
+      throw ModelError(i.where, head + "is derived for trees; this model has nonholonomic constraints (not supported yet)");
+    for (const auto& o : outputs_)
+      if (o.kind == OutputKind::reaction)
+        throw ModelError(i.where, head + "and reaction outputs ('" + o.name +
+                                      "') together are not supported yet");
+  }
+}
+
 void Model::validate() const {
   std::set<std::string> known;
   for (const auto& [name, sym] : symtab_) known.insert(name);
   // Parameters and coordinates (no rates, no inputs); parameters only.
   const std::set<std::string> position_only = symbol_names(true), parameters_only = symbol_names(false);
+  // Where motion inputs may appear: the kinematics of bodies and of markers on the world.
+  std::set<std::string> kinematic = position_only, world_marker = parameters_only;
+  std::vector<Coordinate> kinematic_coordinates = coordinates_;
+  for (std::size_t i = 0; i < inputs_.size(); ++i)
+    if (inputs_[i].motion) {
+      kinematic.insert(inputs_[i].name);
+      world_marker.insert(inputs_[i].name);
+      kinematic_coordinates.push_back({inputs_[i].name, "", input_symbols_[i], inputs_[i].rate, inputs_[i].where});
+    }
   const auto& check_expr = check_symbols;
   auto check_marker = [&](const std::string& name, const SourceLocation& where, const std::string& who) {
     if (!has_marker(name)) {
@@ -600,11 +643,11 @@ void Model::validate() const {
       throw ModelError(b.where, "body '" + b.name + "': parent '" + b.parent +
                                     "' must be defined before its children (a cycle, or out of order)");
     seen.insert(b.name);
-    for (const auto& t : b.translation) check_expr(t, b.where, "a body's translation", position_only);
-    for (const auto& r : b.rotations) check_expr(r.angle, b.where, "a rotation angle", position_only);
+    for (const auto& t : b.translation) check_expr(t, b.where, "a body's translation", kinematic);
+    for (const auto& r : b.rotations) check_expr(r.angle, b.where, "a rotation angle", kinematic);
     if (b.rotation_matrix)
       for (const auto& row : *b.rotation_matrix)
-        for (const auto& x : row) check_expr(x, b.where, "a rotation matrix", position_only);
+        for (const auto& x : row) check_expr(x, b.where, "a rotation matrix", kinematic);
     check_expr(b.mass, b.where, "a mass", parameters_only);
     for (const auto& x : b.com) check_expr(x, b.where, "a centre of mass", parameters_only);
     for (const auto& row : b.inertia)
@@ -620,7 +663,7 @@ void Model::validate() const {
     const std::string inertia_error = inertia_problem(b.inertia, defaults, exact_defaults);
     if (!inertia_error.empty()) throw ModelError(b.where, "body '" + b.name + "' has " + inertia_error);
     if (b.rotation_matrix) {
-      const std::string problem = rotation_problem(*b.rotation_matrix, defaults, coordinates_);
+      const std::string problem = rotation_problem(*b.rotation_matrix, defaults, kinematic_coordinates);
       if (!problem.empty()) throw ModelError(b.where, "body '" + b.name + "': the rotation matrix " + problem);
     }
     if (m == 0 && !inertia_is_zero(b.inertia, defaults))
@@ -631,8 +674,11 @@ void Model::validate() const {
   for (const auto& m : markers_) {
     if (m.body != kWorld && !body_index_.count(m.body))
       throw ModelError(m.where, "marker '" + m.name + "' is on an unknown body '" + m.body + "'");
-    for (const auto& x : m.position) check_expr(x, m.where, "a marker position", parameters_only);
-    const std::string problem = rotation_problem(m.rotation, defaults, coordinates_);
+    const std::set<std::string>& marker_scope = m.body == kWorld ? world_marker : parameters_only;
+    for (const auto& x : m.position) check_expr(x, m.where, "a marker position", marker_scope);
+    for (const auto& row : m.rotation)
+      for (const auto& x : row) check_expr(x, m.where, "a marker rotation", marker_scope);
+    const std::string problem = rotation_problem(m.rotation, defaults, kinematic_coordinates);
     if (!problem.empty()) throw ModelError(m.where, "marker '" + m.name + "': the rotation " + problem);
   }
   for (const auto& s : springs_) {
@@ -674,6 +720,7 @@ void Model::validate() const {
       case OutputKind::position:
       case OutputKind::velocity:
         check_marker(o.marker, o.where, "output '" + o.name + "'");
+        if (!o.relative_to.empty()) check_marker(o.relative_to, o.where, "output '" + o.name + "'");
         for (const auto& x : o.direction) check_expr(x, o.where, "an output direction", parameters_only);
         break;
       case OutputKind::coordinate:
@@ -706,6 +753,7 @@ void Model::validate() const {
   }
   validate_constraints(defaults);
   validate_velocity_constraints();
+  validate_motion_inputs();
   for (const auto& [name, value] : operating_point_.position) {
     if (coordinate_index(name) < 0)
       throw ModelError(operating_point_.where, "operating point names an unknown coordinate '" + name + "'");

@@ -37,7 +37,8 @@ std::vector<Target> targets(LinearEquations& lin, StructuralZeros& z) {
   return {{&lin.M, &z.M},         {&lin.Q, &z.Q},        {&lin.K, &z.K},          {&lin.B, &z.B},
           {&lin.Cy, &z.Cy},       {&lin.Cv, &z.Cv},      {&lin.D, &z.D, true},    {&lin.G, &z.G, true},
           {&lin.Ks, &z.Ks, true}, {&lin.N, &z.N, true},  {&lin.E, &z.E},          {&lin.A, &z.A},
-          {&lin.Bx, &z.Bx},       {&lin.Cx, &z.Cx}};
+          {&lin.Bx, &z.Bx},       {&lin.Cx, &z.Cx},      {&lin.Ca, &z.Ca},        {&lin.Du, &z.Du},
+          {&lin.B1, &z.B1},       {&lin.B2, &z.B2},      {&lin.D1, &z.D1}};
 }
 
 // ---------------------------------------------------------------------------------------------

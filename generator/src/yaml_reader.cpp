@@ -76,9 +76,11 @@ std::string join(const std::vector<std::string>& words) {
 using detail::ExpressionError;
 
 // What an expression may depend on.
-enum class Scope { constants, parameters, positions, no_inputs, any };
+// `kinematics`: a body's translation and rotation (positions and motion inputs);
+// `world_marker`: a marker on the world (parameters and motion inputs).
+enum class Scope { constants, parameters, world_marker, positions, kinematics, no_inputs, any };
 
-enum class SymbolKind { parameter, coordinate, rate, input };
+enum class SymbolKind { parameter, coordinate, rate, input, motion, motion_rate };
 
 const char* kind_name(SymbolKind k) {
   switch (k) {
@@ -86,6 +88,8 @@ const char* kind_name(SymbolKind k) {
     case SymbolKind::coordinate: return "a coordinate";
     case SymbolKind::rate: return "a coordinate rate";
     case SymbolKind::input: return "an input";
+    case SymbolKind::motion: return "a motion input";
+    case SymbolKind::motion_rate: return "the rate of a motion input";
   }
   return "a symbol";
 }
@@ -94,8 +98,12 @@ bool in_scope(SymbolKind k, Scope s) {
   switch (s) {
     case Scope::constants: return false;
     case Scope::parameters: return k == SymbolKind::parameter;
+    case Scope::world_marker: return k == SymbolKind::parameter || k == SymbolKind::motion;
     case Scope::positions: return k == SymbolKind::parameter || k == SymbolKind::coordinate;
-    case Scope::no_inputs: return k != SymbolKind::input;
+    case Scope::kinematics:
+      return k == SymbolKind::parameter || k == SymbolKind::coordinate || k == SymbolKind::motion;
+    case Scope::no_inputs:
+      return k != SymbolKind::input && k != SymbolKind::motion && k != SymbolKind::motion_rate;
     case Scope::any: return true;
   }
   return false;
@@ -105,7 +113,10 @@ const char* scope_phrase(Scope s) {
   switch (s) {
     case Scope::constants: return "must be a constant (numbers, Pi and functions only)";
     case Scope::parameters: return "may depend on parameters only";
+    case Scope::world_marker: return "may depend on parameters and motion inputs only";
     case Scope::positions: return "may depend on parameters and coordinates only (no rates or inputs)";
+    case Scope::kinematics:
+      return "may depend on parameters, coordinates and motion inputs only (no rates or force inputs)";
     case Scope::no_inputs: return "may not depend on inputs";
     case Scope::any: return "";
   }
@@ -476,7 +487,7 @@ GiNaC::ex parse_checked(const Model& model, const std::string& text,
   try {
     detail::check_constants(at, tree, value);
     if (extras && extras->linear_inputs)
-      detail::check_linear_inputs(at, tree, value, model.input_symbols());
+      detail::check_linear_inputs(at, tree, value, model.force_input_symbols());
     if (extras) detail::collect_sites(at, tree, extras->sites);
   } catch (const detail::SiteError& e) {
     throw ExpressionError(e.offset, e.message);
@@ -1041,20 +1052,31 @@ void Reader::read_parameters(const Entry* e) {
 void Reader::read_named_list(const Entry* e, const std::string& what, bool coordinates) {
   for (const auto& n : list(e, what)) {
     std::string item_name, unit;
+    bool motion = false;
     if (n.IsMap()) {
-      const Fields f = fields(n, "an entry of " + what, {"name", "unit"});
+      const Fields f = coordinates ? fields(n, "an entry of " + what, {"name", "unit"})
+                                   : fields(n, "an entry of " + what, {"name", "unit", "kind"});
       item_name = name(require(f, "name", n, "an entry of " + what), "a name");
       if (const Entry* u = find(f, "unit")) unit = scalar(value(*u), "a unit");
+      if (const Entry* k = find(f, "kind")) {
+        const std::string kind = scalar(value(*k), "an input kind");
+        if (kind != "force" && kind != "motion")
+          fail(value(*k), "an input's kind is 'force' (the default) or 'motion', not '" + kind + "'" +
+                              suggestion(kind, {"force", "motion"}));
+        motion = kind == "motion";
+      }
     } else {
-      item_name = scalar(n, "a name or {name, unit} in " + what);
+      item_name = scalar(n, coordinates ? "a name or {name, unit} in " + what
+                                        : "a name or {name, unit, kind} in " + what);
     }
     if (coordinates) {
       model_->add_coordinate(item_name, unit, element_loc(n));
       define(SymbolKind::coordinate, item_name);
       define(SymbolKind::rate, item_name + "_dot");
     } else {
-      model_->add_input(item_name, unit, element_loc(n));
-      define(SymbolKind::input, item_name);
+      model_->add_input(item_name, unit, element_loc(n), motion);
+      define(motion ? SymbolKind::motion : SymbolKind::input, item_name);
+      if (motion) define(SymbolKind::motion_rate, item_name + "_dot");
     }
   }
 }
@@ -1098,12 +1120,12 @@ void Reader::read_body(const YAML::Node& n, const std::set<std::string>& all_bod
       }
     }
   }
-  if (const Entry* t = find(f, "translation")) b.translation = vec3(*t, "a translation", Scope::positions);
+  if (const Entry* t = find(f, "translation")) b.translation = vec3(*t, "a translation", Scope::kinematics);
   const Entry* rot = find(f, "rotation");
   const Entry* rot_m = find(f, "rotation_matrix");
   if (rot && rot_m) fail(rot_m->key, what + ": give either 'rotation' or 'rotation_matrix', not both");
-  if (rot) b.rotations = rotations(*rot, "a rotation", Scope::positions);
-  if (rot_m) b.rotation_matrix = mat3(value(*rot_m), "a rotation matrix", Scope::positions);
+  if (rot) b.rotations = rotations(*rot, "a rotation", Scope::kinematics);
+  if (rot_m) b.rotation_matrix = mat3(value(*rot_m), "a rotation matrix", Scope::kinematics);
   if (const Entry* m = find(f, "mass")) {
     b.mass = expr(*m, "a mass", Scope::parameters);
     const GiNaC::ex m0 = evaluate(value(*m), b.mass, parameter_values());
@@ -1158,15 +1180,17 @@ void Reader::read_marker(const YAML::Node& n, const std::string& body, const YAM
         fail(bn, "unknown body '" + m.body + "'" + suggestion(m.body, names));
     }
   }
-  if (const Entry* p = find(f, "position")) m.position = vec3(*p, "a marker position", Scope::parameters);
+  // A marker on the world may move with motion inputs (prescribed_motion.hpp).
+  const Scope scope = m.body == kWorld ? Scope::world_marker : Scope::parameters;
+  if (const Entry* p = find(f, "position")) m.position = vec3(*p, "a marker position", scope);
   const Entry* rot = find(f, "rotation");
   const Entry* rot_m = find(f, "rotation_matrix");
   if (rot && rot_m)
     fail(rot_m->key, "marker '" + m.name + "': give either 'rotation' or 'rotation_matrix', not both");
   if (rot)
-    for (const auto& r : rotations(*rot, "a marker rotation", Scope::parameters))
+    for (const auto& r : rotations(*rot, "a marker rotation", scope))
       m.rotation = multiply(m.rotation, rotation_matrix(r));
-  if (rot_m) m.rotation = mat3(value(*rot_m), "a marker rotation matrix", Scope::parameters);
+  if (rot_m) m.rotation = mat3(value(*rot_m), "a marker rotation matrix", scope);
   used_names_.insert(m.name);
   model_->add_marker(m);
 }
@@ -1319,7 +1343,7 @@ void Reader::read_output(const YAML::Node& n) {
     fail(type_node, "unknown output type '" + type + "'" + hint);
   }
   std::vector<std::string> keys = {"name", "type", "unit"};
-  if (type == "position" || type == "velocity") keys.insert(keys.end(), {"marker", "direction"});
+  if (type == "position" || type == "velocity") keys.insert(keys.end(), {"marker", "direction", "relative_to"});
   if (type == "coordinate" || type == "rate") keys.insert(keys.end(), {"coordinate"});
   if (type == "expression") keys.insert(keys.end(), {"expression"});
   if (type == "reaction") keys.insert(keys.end(), {"of", "quantity", "direction", "frame"});
@@ -1334,6 +1358,7 @@ void Reader::read_output(const YAML::Node& n) {
     o.kind = type == "position" ? OutputKind::position : OutputKind::velocity;
     o.marker = check_marker(value(require(f, "marker", n, what)));
     o.direction = vec3(require(f, "direction", n, what), "an output direction", Scope::parameters);
+    if (const Entry* r = find(f, "relative_to")) o.relative_to = check_marker(value(*r));
   } else if (type == "coordinate" || type == "rate") {
     o.kind = type == "coordinate" ? OutputKind::coordinate : OutputKind::rate;
     o.coordinate = check_coordinate(value(require(f, "coordinate", n, what)));

@@ -498,6 +498,20 @@ struct FrequencyResponse::Impl {
     Cv_re = Cv.real();
   }
 
+  /// The right-hand side b and the feedthrough d(rows) of one part of a moving support's
+  /// excitation (FrequencyResponse::compute): B1's or B2's column and D1's or none.
+  void select_part(const Eigen::MatrixXd& Bk, const Eigen::MatrixXd* Dk, const std::vector<Index>& rows,
+                   Index input) {
+    if (Bk.size() != 0) b = Bk.col(input);
+    else b.setZero(n);
+    feed.setZero(static_cast<Index>(rows.size()));
+    if (Dk && Dk->size() != 0)
+      for (std::size_t r = 0; r < rows.size(); ++r) feed[static_cast<Index>(r)] = (*Dk)(rows[r], input);
+    bool acc = false;
+    for (Index a : acc_row) acc = acc || a >= 0;
+    combine = acc || (feed.array() != 0.0).any();
+  }
+
   /// ẑ_r = (C_y + iΩC_v)_r ŷ − Ω²(C_a ŷ)_r + D(r, input) for the p outputs, in place in z's
   /// first p entries (the pseudo-rows are read before being overwritten: their index is ≥ p).
   void combine_outputs(double om) {
@@ -1301,8 +1315,37 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
     case FrfMethod::automatic: break;
   }
 
+  sweep(omega, m, p, response_);
+  // A moving support (LinearModel::B1): the response to B(Ω) = B + iΩB1 − Ω²B2 is, by
+  // linearity, that to B plus iΩ times that to B1 (with D1) minus Ω² times that to B2: two more
+  // sweeps with the same factorizations, every method unchanged.
+  if (model_.input_has_rates(input)) {
+    for (int part = 1; part <= 2; ++part) {
+      im.select_part(part == 1 ? model_.B1() : model_.B2(), part == 1 ? &model_.D1() : nullptr, rows, input);
+      switch (m) {
+        case FrfMethod::banded: im.select_banded(); break;
+        case FrfMethod::hessenberg: im.select_hessenberg(); break;
+        case FrfMethod::modal: im.select_modal(options_, warnings_); break;
+        case FrfMethod::real: im.select_real(); break;
+        default: break;
+      }
+      Eigen::MatrixXcd z;
+      sweep(omega, m, p, z);
+      for (Index k = 0; k < omega.size(); ++k) {
+        const cd factor = part == 1 ? cd(0.0, omega[k]) : cd(-omega[k] * omega[k], 0.0);
+        if (flags_[static_cast<std::size_t>(k)] != FrfFlag::pole) response_.col(k) += factor * z.col(k);
+      }
+    }
+  }
+  info_ = Eigen::Success;
+  return *this;
+}
+
+void FrequencyResponse::sweep(const Eigen::VectorXd& omega, FrfMethod m, Index p, Eigen::MatrixXcd& out) {
+  Impl& im = *impl_;
+  const Index n = model_.size();
   const Index F = omega.size();
-  response_.resize(p, F);
+  out.resize(p, F);
   rcond_.resize(F);
   flags_.assign(static_cast<std::size_t>(F), FrfFlag::ok);
   const double pole_rc =
@@ -1337,13 +1380,11 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
           << hz(om) << ", rcond = " << rc << " (an undamped resonance?)";
         throw SingularSystemError(s.str());
       }
-      response_.col(k).setConstant(cd(kNaN, kNaN));
+      out.col(k).setConstant(cd(kNaN, kNaN));
     } else {
-      response_.col(k) = im.z.head(p);
+      out.col(k) = im.z.head(p);
     }
   }
-  info_ = Eigen::Success;
-  return *this;
 }
 
 }  // namespace mbsgen

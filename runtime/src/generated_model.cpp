@@ -256,11 +256,19 @@ LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
                   name_list(k_.input_names, k_.n_inputs), name_list(k_.output_names, k_.n_outputs),
                   name_list(k_.coordinate_units, k_.n_coordinates),
                   name_list(k_.input_units, k_.n_inputs), name_list(k_.output_units, k_.n_outputs));
-  if (!k_.output_terms) return lin;
-  Eigen::MatrixXd Ca(r, f), D(r, m);
-  check_status(k_.output_terms(op.y0.data(), op.yd0.data(), p_.data(), ptr(Ca), ptr(D)),
-               "output_terms", k_.model);
-  return lin.with_output_terms(std::move(Ca), std::move(D));
+  if (k_.output_terms) {
+    Eigen::MatrixXd Ca(r, f), D(r, m);
+    check_status(k_.output_terms(op.y0.data(), op.yd0.data(), p_.data(), ptr(Ca), ptr(D)),
+                 "output_terms", k_.model);
+    lin = lin.with_output_terms(std::move(Ca), std::move(D));
+  }
+  if (k_.excitation) {
+    Eigen::MatrixXd B1(f, m), B2(f, m), D1(r, m);
+    check_status(k_.excitation(op.y0.data(), op.yd0.data(), p_.data(), ptr(B1), ptr(B2), ptr(D1)),
+                 "excitation", k_.model);
+    lin = lin.with_input_rates(std::move(B1), std::move(B2), std::move(D1));
+  }
+  return lin;
 }
 
 }  // namespace mbsgen

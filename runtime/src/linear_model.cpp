@@ -137,6 +137,30 @@ LinearModel LinearModel::with_output_terms(Eigen::MatrixXd C_a, Eigen::MatrixXd 
   return copy;
 }
 
+LinearModel LinearModel::with_input_rates(Eigen::MatrixXd B1, Eigen::MatrixXd B2, Eigen::MatrixXd D1) const {
+  constexpr const char* who = "LinearModel::with_input_rates";
+  const Eigen::Index p = num_outputs(), f = size(), m = num_inputs();
+  auto is_empty = [](const Eigen::MatrixXd& A) { return A.rows() == 0 && A.cols() == 0; };
+  if (!is_empty(B1)) check_dims(B1, f, m, "B1", "f x m, the size of B", who);
+  if (!is_empty(B2)) check_dims(B2, f, m, "B2", "f x m, the size of B", who);
+  if (!is_empty(D1)) check_dims(D1, p, m, "D1", "p x m, one row per output, one column per input", who);
+  check_finite(B1, "B1", who);
+  check_finite(B2, "B2", who);
+  check_finite(D1, "D1", who);
+  LinearModel copy(*this);
+  auto keep = [](Eigen::MatrixXd& A) { return (A.array() != 0.0).any() ? std::move(A) : Eigen::MatrixXd(); };
+  copy.B1_ = keep(B1);
+  copy.B2_ = keep(B2);
+  copy.D1_ = keep(D1);
+  return copy;
+}
+
+bool LinearModel::input_has_rates(Eigen::Index j) const {
+  for (const Eigen::MatrixXd* A : {&B1_, &B2_, &D1_})
+    if (A->size() != 0 && (A->col(j).array() != 0.0).any()) return true;
+  return false;
+}
+
 bool LinearModel::is_symmetric_undamped() const {
   return !has_Q_ && M_ == M_.transpose() && K_ == K_.transpose();
 }

@@ -358,6 +358,14 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   if (!o.inputs.empty() && o.inputs.size() != static_cast<std::size_t>(k.n_inputs))
     throw DimensionError("simulate: " + std::to_string(o.inputs.size()) + " input signals for " +
                          std::to_string(k.n_inputs) + " inputs");
+  // The kernels hold a moving support at rest (prescribed_motion.hpp): a signal on a motion
+  // input would be silently lost.
+  if (k.input_kinds)
+    for (std::size_t j = 0; j < o.inputs.size(); ++j)
+      if (std::string(k.input_kinds[j]) == "motion" && !o.inputs[j].is_zero())
+        throw Error("simulate: input '" + std::string(k.input_names[j]) +
+                    "' prescribes motion; a moving support is taken by the linear analyses (frf, "
+                    "static), not yet by simulate");
 }
 
 // The reason a CVode flag gives, and the time.

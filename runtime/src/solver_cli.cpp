@@ -295,6 +295,10 @@ int run_matrices(const ModelKernels& k, const Options& o, std::ostream& out, std
     // Outputs on ÿ and u (joint loads; the kernels' optional output_terms): only when nonzero.
     if (lin.has_output_accelerations()) mats.push_back({"C_a", &lin.C_a()});
     if (lin.has_feedthrough()) mats.push_back({"D", &lin.D()});
+    // A moving support's rates and accelerations (prescribed motion): only when nonzero.
+    if (lin.B1().size()) mats.push_back({"B1", &lin.B1()});
+    if (lin.B2().size()) mats.push_back({"B2", &lin.B2()});
+    if (lin.D1().size()) mats.push_back({"D1", &lin.D1()});
   }
   if (o.format == "mtx") {
     namespace fs = std::filesystem;

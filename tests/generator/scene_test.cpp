@@ -98,6 +98,7 @@ const SceneCase kCases[] = {
     {"chain3_sympy_no_damping", "chain3_sympy", {"c1", "c2", "c3"}},
     {"chain3_sympy_frf", "chain3_sympy", {}},
     {"chain3_sympy_sag", "chain3_sympy", {"c1", "c2", "c3"}},
+    {"base_excited_oscillator_shaker", "base_excited_oscillator", {}},
     {"planar_chain_3_no_gravity", "planar_chain_3", {"g"}},
     {"planar_chain_3_no_damping", "planar_chain_3", {"c1", "c2", "c3"}},
     {"spatial_chain_3_no_gravity", "spatial_chain_3", {"g"}},

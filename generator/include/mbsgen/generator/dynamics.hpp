@@ -11,6 +11,7 @@
 #pragma once
 
 #include "mbsgen/generator/nonholonomic.hpp"
+#include "mbsgen/generator/prescribed_motion.hpp"
 
 #include <vector>
 
@@ -45,6 +46,9 @@ struct Equations {
   LoopClosure loops;
   /// Nonholonomic constraints (nonholonomic.hpp), built after the loops.
   Nonholonomic nonholonomic;
+  /// Motion inputs (prescribed_motion.hpp): M, residual, outputs, JT, JR and the kinematics
+  /// above are then those with the support at rest, and `motion` holds what its motion adds.
+  PrescribedMotion motion;
   struct Tree {
     ExMatrix M, JT, JR;
     std::vector<GiNaC::ex> residual, outputs;

@@ -37,6 +37,9 @@ struct LinearEquations {
   /// Outputs that depend on accelerations and inputs (reaction forces, reactions.hpp):
   /// z_s = C_y y_s + C_v y_s' + C_a y_s'' + D_u u. Empty when no output does.
   ExMatrix Ca, Du;              ///< r×f, r×m
+  /// Prescribed motion (prescribed_motion.hpp): h = B u + B1 u̇ + B2 ü and z += D1 u̇ (f×m,
+  /// f×m, r×m; zero columns for force inputs). Empty without motion inputs.
+  ExMatrix B1, B2, D1;
   std::vector<GiNaC::ex> y0, yd0;  ///< default operating point (expressions in p)
   bool equilibrium = false;     ///< y0 is an initial guess for a static equilibrium
   /// D, G, N vanish at the operating point for all parameter values (the manifest's

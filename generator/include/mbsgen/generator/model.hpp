@@ -150,11 +150,17 @@ struct AppliedForce {
   SourceLocation where;
 };
 
-/// A named excitation amplitude; its symbol may appear (linearly) in force expressions.
+/// A named excitation amplitude. A force input's symbol may appear (linearly) in force
+/// expressions. A motion input prescribes motion (docs/model-format.md, "Prescribed motion"):
+/// its symbol u is a coordinate whose value is given, with the rate `NAME_dot`; it may appear in
+/// body translations and rotations, in the positions and rotations of markers on the world, and
+/// in forces. Linearized, it excites through h = B0 u + B1 u̇ + B2 ü (prescribed_motion.hpp).
 struct Input {
   std::string name;
   std::string unit;
   SourceLocation where;
+  bool motion = false;
+  GiNaC::symbol rate;  ///< motion: u̇, written `NAME_dot`
 };
 
 /// A holonomic constraint Φ(y) = 0 that closes a kinematic loop (docs/model-format.md,
@@ -225,6 +231,10 @@ struct Output {
   OutputKind kind = OutputKind::coordinate;
   std::string marker;               ///< position, velocity
   Vec3 direction = zero_vec3();     ///< world frame, position and velocity
+  /// position, velocity: when set, the motion relative to this marker's point and frame,
+  /// directionᵀ S_Rᵀ (r − r_R) and its time derivative, with direction in the frame of R (the
+  /// stapes relative to the vibrating cochlea).
+  std::string relative_to;
   std::string coordinate;           ///< coordinate, rate
   GiNaC::ex expression;             ///< expression
   /// force: the force [N] (or torque [N m], about the point of marker b) that the named force
@@ -374,6 +384,8 @@ class Model;
 Model apply_scene(const Model& model, const std::string& scene);
 /// The model with six probe coordinates in the joints of the named bodies (reactions.hpp).
 Model with_joint_probes(const Model& model, const std::vector<std::string>& bodies);
+/// The model with its motion inputs as coordinates after its own (prescribed_motion.hpp).
+Model with_motion_coordinates(const Model& model);
 
 /// A multibody model. Add parameters, coordinates and inputs first (they create the symbols that
 /// expressions use), then bodies, markers, forces and outputs. `validate()` checks the whole.
@@ -388,8 +400,9 @@ class Model {
                                      const SourceLocation& where = {});
   const Coordinate& add_coordinate(const std::string& name, const std::string& unit = "",
                                    const SourceLocation& where = {});
+  /// A force input, or with `motion` a motion input (which also defines `NAME_dot`).
   const GiNaC::symbol& add_input(const std::string& name, const std::string& unit = "",
-                                 const SourceLocation& where = {});
+                                 const SourceLocation& where = {}, bool motion = false);
   void add_body(Body body);
   void add_marker(Marker marker);
   void add_gravity(Gravity gravity);
@@ -439,6 +452,10 @@ class Model {
   const std::vector<Coordinate>& coordinates() const { return coordinates_; }
   const std::vector<Input>& inputs() const { return inputs_; }
   const std::vector<GiNaC::symbol>& input_symbols() const { return input_symbols_; }
+  /// The symbols of the force inputs (those that must enter forces linearly).
+  std::vector<GiNaC::symbol> force_input_symbols() const;
+  /// True when some input prescribes motion.
+  bool has_motion_inputs() const;
   const std::vector<Body>& bodies() const { return bodies_; }
   const std::vector<Marker>& markers() const { return markers_; }
   const std::vector<Gravity>& gravity() const { return gravity_; }
@@ -484,6 +501,7 @@ class Model {
  private:
   friend Model apply_scene(const Model& model, const std::string& scene);
   friend Model with_joint_probes(const Model& model, const std::vector<std::string>& bodies);
+  friend Model with_motion_coordinates(const Model& model);
 
   void check_new_symbol(const std::string& name, const SourceLocation& where);
   void check_new_element(const std::string& name, const char* kind, const SourceLocation& where);
@@ -493,6 +511,7 @@ class Model {
                             const std::set<std::string>& allowed);
   void validate_constraints(const GiNaC::exmap& defaults) const;
   void validate_velocity_constraints() const;
+  void validate_motion_inputs() const;
   void validate_rolling(const Constraint& c, const std::string& who, const GiNaC::exmap& defaults,
                         const std::set<std::string>& parameters_only) const;
 

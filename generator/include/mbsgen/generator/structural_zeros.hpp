@@ -44,6 +44,8 @@ struct StructuralZeros {
   /// Patterns of M, Q, K, B, C_y, C_v, D, G, K_s, N (sizes as the matrices).
   ZeroPattern M, Q, K, B, Cy, Cv, D, G, Ks, N;
   ZeroPattern E, A, Bx, Cx;  ///< the descriptor matrices of a nonholonomic model
+  ZeroPattern Ca, Du;        ///< outputs on ÿ and u (reactions.hpp, prescribed_motion.hpp)
+  ZeroPattern B1, B2, D1;    ///< a moving support's rates and accelerations (prescribed_motion.hpp)
   std::size_t everywhere = 0;           ///< entries proved zero for all kernel arguments
   std::size_t at_operating_point = 0;   ///< entries proved zero at the operating point only
   std::size_t unproved = 0;             ///< numerically zero candidates not proved (kept)

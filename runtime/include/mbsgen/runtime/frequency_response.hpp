@@ -171,6 +171,9 @@ class FrequencyResponse {
 
  private:
   struct Impl;  // per-method workspaces (frequency_response.cpp)
+  /// One pass over the frequencies with the selected right-hand side: `out` (p×F), rcond_ and
+  /// flags_ (the same for every right-hand side of one input).
+  void sweep(const Eigen::VectorXd& omega, FrfMethod m, Eigen::Index p, Eigen::MatrixXcd& out);
   const LinearModel& model_;
   FrfOptions options_;
   std::unique_ptr<Impl> impl_;

@@ -108,6 +108,13 @@ struct ModelKernels {
   int (*outputs_full)(const double* y, const double* yd, const double* p, double* z) = nullptr;
   int (*outputs_general_full)(const double* y, const double* yd, const double* ydd, const double* u,
                               const double* p, double* z) = nullptr;
+  /// Prescribed motion (issue 19; null: every input is a force): per input "force" or "motion",
+  /// and the terms a moving support adds at the operating point, column-major: B1, B2
+  /// (n_coordinates×n_inputs) of h = B u + B1 u̇ + B2 ü, and D1 (n_outputs×n_inputs) of
+  /// z += D1 u̇ (the outputs' D u comes from output_terms). Trailing.
+  const char* const* input_kinds = nullptr;
+  int (*excitation)(const double* y0, const double* yd0, const double* p, double* B1, double* B2,
+                    double* D1) = nullptr;
 };
 
 /// The first n entries of a kernel name array (null entries become "").

@@ -68,6 +68,21 @@ class LinearModel {
   /// "LinearModel::with_output_terms", the matrix and its dimensions.
   LinearModel with_output_terms(Eigen::MatrixXd C_a, Eigen::MatrixXd D) const;
 
+  /// Prescribed motion (issue 19): inputs that move a support excite through their rates and
+  /// accelerations too, M ÿ + Q ẏ + K y = B u + B1 u̇ + B2 ü and z += D1 u̇, so that a harmonic
+  /// input sees B(Ω) = B + iΩB1 − Ω²B2 and D(Ω) = D + iΩD1. B1 (f×m, N s/m …), B2 (f×m) and
+  /// D1 (p×m), each 0×0 when zero (has_input_rates() false without any).
+  const Eigen::MatrixXd& B1() const { return B1_; }
+  const Eigen::MatrixXd& B2() const { return B2_; }
+  const Eigen::MatrixXd& D1() const { return D1_; }
+  bool has_input_rates() const { return B1_.size() != 0 || B2_.size() != 0 || D1_.size() != 0; }
+  /// True when input j has a nonzero column of B1, B2 or D1.
+  bool input_has_rates(Eigen::Index j) const;
+  /// A copy with these B1, B2 (f×m) and D1 (p×m), each possibly empty (0×0, zero); an exactly
+  /// zero matrix is stored empty. Throws DimensionError or NonFiniteError naming
+  /// "LinearModel::with_input_rates", the matrix and its dimensions.
+  LinearModel with_input_rates(Eigen::MatrixXd B1, Eigen::MatrixXd B2, Eigen::MatrixXd D1) const;
+
   bool has_damping() const { return has_Q_; }  ///< false when Q is exactly zero
   /// True when M and K are exactly symmetric and Q is exactly zero (fast path of the modes).
   bool is_symmetric_undamped() const;
@@ -85,6 +100,7 @@ class LinearModel {
  private:
   Eigen::MatrixXd M_, Q_, K_, B_, C_y_, C_v_;
   Eigen::MatrixXd C_a_, D_;  // 0×0 when zero
+  Eigen::MatrixXd B1_, B2_, D1_;  // 0×0 when zero
   std::vector<std::string> coordinate_names_, input_names_, output_names_;
   std::vector<std::string> coordinate_units_, input_units_, output_units_;
   bool has_Q_ = false;

@@ -64,6 +64,8 @@ class InputSignal {
   static InputSignal parse(const std::string& spec, double duration);
 
   double operator()(double t) const;
+  /// True for the default signal (zero for all time).
+  bool is_zero() const { return kind_ == Kind::constant && a_ == 0; }
   /// Times where the signal jumps (a step): the integrator restarts there.
   const std::vector<double>& breakpoints() const { return breakpoints_; }
   /// Times where its slope jumps (a table's points): the integrator stops there, so that it

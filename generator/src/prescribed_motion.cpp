@@ -1,0 +1,150 @@
+// Stage 2b: prescribed motion (prescribed_motion.hpp).
+#include "mbsgen/generator/prescribed_motion.hpp"
+
+#include "mbsgen/generator/dynamics.hpp"
+
+namespace mbsgen {
+
+using GiNaC::ex;
+
+namespace {
+
+bool moves(const Marker& m, const std::vector<GiNaC::symbol>& motion) {
+  for (const auto& s : motion) {
+    for (const auto& x : m.position)
+      if (x.has(s)) return true;
+    for (const auto& row : m.rotation)
+      for (const auto& x : row)
+        if (x.has(s)) return true;
+  }
+  return false;
+}
+
+std::string fresh_body(const Model& model, std::string base) {
+  while (model.has_marker(base) || [&] {
+    for (const auto& b : model.bodies())
+      if (b.name == base) return true;
+    return false;
+  }())
+    base += "_";
+  return base;
+}
+
+}  // namespace
+
+// The motion inputs become coordinates after the model's own (their symbols and rates are the
+// inputs'), and leave the inputs; a marker on the world that moves with them is carried by a
+// massless body of its own, driven by them, appended after the model's bodies.
+Model with_motion_coordinates(const Model& model) {
+  Model moving = model;
+  moving.inputs_.clear();
+  moving.input_symbols_.clear();
+  std::vector<GiNaC::symbol> motion;
+  for (std::size_t i = 0; i < model.inputs().size(); ++i) {
+    const Input& in = model.inputs()[i];
+    if (!in.motion) {
+      moving.inputs_.push_back(in);
+      moving.input_symbols_.push_back(model.input_symbols()[i]);
+      continue;
+    }
+    motion.push_back(model.input_symbols()[i]);
+    moving.coordinates_.push_back({in.name, in.unit, model.input_symbols()[i], in.rate, in.where});
+  }
+  for (Marker& m : moving.markers_) {
+    if (m.body != kWorld || !moves(m, motion)) continue;
+    Body carrier;
+    carrier.name = fresh_body(moving, "support_of_" + m.name);
+    carrier.translation = m.position;
+    carrier.rotation_matrix = m.rotation;
+    carrier.where = m.where;
+    m.body = carrier.name;
+    m.position = zero_vec3();
+    m.rotation = identity_mat3();
+    moving.add_body(carrier);
+  }
+  return moving;
+}
+
+namespace {
+
+// Everything of the tree's kinematics at the support's rest (u = u̇ = 0), without the columns of
+// the motion coordinates and the carrier bodies of moving world markers.
+void kinematics_at_rest(Kinematics& kin, std::size_t n, std::size_t bodies,
+                        const std::function<ex(const ex&)>& at0) {
+  auto vec = [&](Vec3& v) {
+    for (auto& x : v) x = at0(x);
+  };
+  auto mat = [&](Mat3& A) {
+    for (auto& row : A) vec(row);
+  };
+  kin.bodies.resize(bodies);
+  for (BodyKinematics& b : kin.bodies) {
+    mat(b.S), vec(b.r), vec(b.com), mat(b.I_com);
+    vec(b.V.w), vec(b.V.v), vec(b.bias.w), vec(b.bias.v);
+    b.inertia.m = at0(b.inertia.m), vec(b.inertia.h), mat(b.inertia.J);
+    std::vector<JointColumn> kept;
+    for (JointColumn col : b.columns)
+      if (static_cast<std::size_t>(col.coordinate) < n) {
+        vec(col.phi.w), vec(col.phi.v);
+        kept.push_back(col);
+      }
+    b.columns = kept;
+  }
+}
+
+}  // namespace
+
+void split_prescribed_motion(const Model& model, std::size_t bodies, Equations& eq) {
+  Program& prog = eq.program;
+  const std::size_t n = model.coordinates().size(), all = eq.y.size();
+  PrescribedMotion& pm = eq.motion;
+  pm.active = true;
+  GiNaC::exmap zero, still;
+  for (std::size_t c = n; c < all; ++c) {
+    zero[eq.y[c]] = 0;
+    zero[eq.yd[c]] = 0;
+    still[eq.yd[c]] = 0;
+    pm.rates.push_back(eq.yd[c]);
+  }
+  // The inputs in the model's order; the motion coordinates follow the motion inputs' order.
+  eq.u = model.input_symbols();
+  for (std::size_t i = 0; i < model.inputs().size(); ++i)
+    if (model.inputs()[i].motion) pm.inputs.push_back(i);
+
+  pm.M.assign(n, std::vector<ex>(all - n, 0));
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t c = n; c < all; ++c) pm.M[j][c - n] = eq.M[j][c];
+  pm.residual.assign(eq.residual.begin(), eq.residual.begin() + static_cast<long>(n));
+  pm.outputs = eq.outputs;
+
+  Program::Substitution sub(zero), held(still);
+  auto at0 = [&](const ex& e) { return prog.substitute(e, sub); };
+  // k − q keeps the support's displacement u (held still, u̇ = 0), as the residual kernels take
+  // every input; the rest is at the support's reference place.
+  auto at_rest = [&](const ex& e) { return prog.substitute(e, held); };
+  eq.y.resize(n);
+  eq.yd.resize(n);
+  if (eq.accelerations.size() > n) eq.accelerations.resize(n);
+  eq.M.resize(n);
+  for (auto& row : eq.M) {
+    row.resize(n);
+    for (auto& x : row) x = at0(x);
+  }
+  eq.residual.resize(n);
+  for (auto& x : eq.residual) x = at_rest(x);
+  if (!eq.residual_kernel.empty()) {
+    eq.residual_kernel.resize(n);
+    for (auto& x : eq.residual_kernel) x = at_rest(x);
+  }
+  for (auto& x : eq.outputs) x = at0(x);
+  for (ExMatrix* J : {&eq.JT, &eq.JR}) {
+    J->resize(3 * bodies);
+    for (auto& row : *J) {
+      row.resize(n);
+      for (auto& x : row) x = at0(x);
+    }
+  }
+  kinematics_at_rest(eq.kinematics, n, bodies, at0);
+}
+
+}  // namespace mbsgen
