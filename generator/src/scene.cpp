@@ -215,6 +215,25 @@ std::vector<EffectState> effects_of(const Model& model) {
   return effects;
 }
 
+// The kinematics of a scene without some motion inputs: those supports stay in their reference
+// place (their inputs and rates 0 in body translations and rotations and in markers on the world).
+void hold_dropped_supports(Model& m, const GiNaC::exmap& dropped) {
+  if (dropped.empty()) return;
+  auto held = [&](const ex& e) { return e.subs(dropped, GiNaC::subs_options::no_pattern); };
+  auto vec = [&](Vec3& v) {
+    for (auto& x : v) x = held(x);
+  };
+  auto mat = [&](Mat3& A) {
+    for (auto& row : A) vec(row);
+  };
+  for (Body& b : m.bodies_) {
+    vec(b.translation);
+    for (auto& r : b.rotations) r.angle = held(r.angle);
+    if (b.rotation_matrix) mat(*b.rotation_matrix);
+  }
+  for (Marker& mk : m.markers_) vec(mk.position), mat(mk.rotation);
+}
+
 Model apply_scene(const Model& model, const std::string& name) {
   const Scene* scene = model.scene(name);
   if (!scene && name != kFullScene) {
@@ -296,7 +315,13 @@ Model apply_scene(const Model& model, const std::string& name) {
     dropped[model.input_symbols()[i]] = 0;
     m.symtab_.erase(n);
     m.symbol_names_.erase(n);
+    if (model.inputs()[i].motion) {  // a support the scene holds still in its reference place
+      dropped[model.inputs()[i].rate] = 0;
+      m.symtab_.erase(n + "_dot");
+      m.symbol_names_.erase(n + "_dot");
+    }
   }
+  hold_dropped_supports(m, dropped);
   auto without_inputs = [&](const ex& e) {
     return dropped.empty() ? e : e.subs(dropped, GiNaC::subs_options::no_pattern);
   };

@@ -386,6 +386,8 @@ Model apply_scene(const Model& model, const std::string& scene);
 Model with_joint_probes(const Model& model, const std::vector<std::string>& bodies);
 /// The model with its motion inputs as coordinates after its own (prescribed_motion.hpp).
 Model with_motion_coordinates(const Model& model);
+/// Sets the dropped motion inputs of a scene (and their rates) to 0 in the kinematics (scene.hpp).
+void hold_dropped_supports(Model& m, const GiNaC::exmap& dropped);
 
 /// A multibody model. Add parameters, coordinates and inputs first (they create the symbols that
 /// expressions use), then bodies, markers, forces and outputs. `validate()` checks the whole.
@@ -502,6 +504,7 @@ class Model {
   friend Model apply_scene(const Model& model, const std::string& scene);
   friend Model with_joint_probes(const Model& model, const std::vector<std::string>& bodies);
   friend Model with_motion_coordinates(const Model& model);
+  friend void hold_dropped_supports(Model& m, const GiNaC::exmap& dropped);
 
   void check_new_symbol(const std::string& name, const SourceLocation& where);
   void check_new_element(const std::string& name, const char* kind, const SourceLocation& where);
