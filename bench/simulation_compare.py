@@ -114,7 +114,12 @@ def main():
             x0[i] = v
 
         def u_of(t):
-            return np.array([tone[0] * np.sin(2 * np.pi * tone[1] * t)]) if tone else np.zeros(max(m, 1))
+            # The tone drives the first input (the middle ear's P; its others move the temporal
+            # bone, held still here); one entry per input, as the kernels read.
+            u = np.zeros(max(m, 1))
+            if tone:
+                u[0] = tone[0] * np.sin(2 * np.pi * tone[1] * t)
+            return u
 
         def f(t, x):
             return np.concatenate((x[n:], model.accelerations(x[:n], x[n:], u_of(t))))

@@ -46,7 +46,10 @@ std::vector<Problem> problems() {
   }
   {
     mbsgen::SimulationOptions o;
-    o.duration = 0.02, o.step = 1e-5, o.inputs = {mbsgen::InputSignal::sine(1.0, 1000)};
+    o.duration = 0.02, o.step = 1e-5;
+    // P (input 0); the others move the temporal bone (bone conduction), held still.
+    o.inputs.assign(static_cast<std::size_t>(middle_ear::kernels().n_inputs), mbsgen::InputSignal());
+    o.inputs[0] = mbsgen::InputSignal::sine(1.0, 1000);
     p.push_back({"middle_ear", &middle_ear::kernels(), o, 1e-9});  // displacements of nanometres
   }
   return p;

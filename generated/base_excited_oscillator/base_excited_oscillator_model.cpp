@@ -11,7 +11,6 @@ const char* const coordinate_units[] = {"m", nullptr};
 const char* const parameter_units[] = {"kg", "N/m", "N s/m", nullptr};
 const char* const input_units[] = {"m", "N", nullptr};
 const char* const output_units[] = {"m", "m/s", "m", "m/s", "m", "N", nullptr};
-const char* const input_kinds[] = {"motion", "force", nullptr};
 }  // namespace
 
 std::array<double, 3> Parameters::values() const {
@@ -30,7 +29,7 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr,
       0, 0, nullptr, nullptr,
       nullptr, nullptr, nullptr, nullptr,
-      input_kinds, &base_excited_oscillator_excitation};
+      base_excited_oscillator_input_kinds, &base_excited_oscillator_excitation};
   return k;
 }
 

@@ -52,6 +52,7 @@ extern "C" const char* const chain3_sympy_coordinate_names[] = {"q1", "q2", "q3"
 extern "C" const char* const chain3_sympy_parameter_names[] = {"m1", "m2", "m3", "l1", "l2", "l3", "k1", "k2", "k3", "c1", "c2", "c3", "g", nullptr};
 extern "C" const char* const chain3_sympy_input_names[] = {"F", nullptr};
 extern "C" const char* const chain3_sympy_output_names[] = {"end_x", "end_vx", "relative_angle3", nullptr};
+extern "C" const char* const chain3_sympy_input_kinds[] = {"force", nullptr};
 extern "C" const double chain3_sympy_parameter_defaults[] = {1.0, 1.5, 2.0, 0.5, 0.40000000000000002, 0.29999999999999999, 10.0, 20.0, 30.0, 0.10000000000000001, 0.20000000000000001, 0.29999999999999999, 9.8100000000000005, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

@@ -52,6 +52,7 @@ extern "C" const char* const double_pendulum_coordinate_names[] = {"phi1", "phi2
 extern "C" const char* const double_pendulum_parameter_names[] = {"m1", "m2", "l1", "l2", "g", nullptr};
 extern "C" const char* const double_pendulum_input_names[] = {"F", nullptr};
 extern "C" const char* const double_pendulum_output_names[] = {"tip_x", "tip_vx", "upper_angle", "relative_angle", nullptr};
+extern "C" const char* const double_pendulum_input_kinds[] = {"force", nullptr};
 extern "C" const double double_pendulum_parameter_defaults[] = {1.0, 1.0, 1.0, 1.0, 9.8100000000000005, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

@@ -52,6 +52,7 @@ extern "C" const char* const double_pendulum_rods_coordinate_names[] = {"phi1", 
 extern "C" const char* const double_pendulum_rods_parameter_names[] = {"m", "l", "g", nullptr};
 extern "C" const char* const double_pendulum_rods_input_names[] = {nullptr};
 extern "C" const char* const double_pendulum_rods_output_names[] = {"tip_x", nullptr};
+extern "C" const char* const double_pendulum_rods_input_kinds[] = {nullptr};
 extern "C" const double double_pendulum_rods_parameter_defaults[] = {1.0, 1.0, 9.8100000000000005, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

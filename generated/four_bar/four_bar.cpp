@@ -52,6 +52,7 @@ extern "C" const char* const four_bar_coordinate_names[] = {"th1", nullptr};
 extern "C" const char* const four_bar_parameter_names[] = {"g", "a", "l1", "l2", "l3", "m", "k", "L0", nullptr};
 extern "C" const char* const four_bar_input_names[] = {"T", nullptr};
 extern "C" const char* const four_bar_output_names[] = {"pin_fx", "pin_fy", "pivot_fx", "pivot_fy", "crank_angle", nullptr};
+extern "C" const char* const four_bar_input_kinds[] = {"force", nullptr};
 extern "C" const char* const four_bar_tree_coordinate_names[] = {"th1", "th2", "th3", nullptr};
 extern "C" const double four_bar_parameter_defaults[] = {9.8100000000000005, 0.40000000000000002, 0.10000000000000001, 0.34999999999999998, 0.25, 0.29999999999999999, 40.0, 0.10000000000000001, 0.0};
 

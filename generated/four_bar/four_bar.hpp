@@ -49,6 +49,8 @@ extern const char* const four_bar_coordinate_names[];
 extern const char* const four_bar_parameter_names[];
 extern const double four_bar_parameter_defaults[];
 extern const char* const four_bar_input_names[];
+// Per input "force" or "motion" (a motion input prescribes a support's motion).
+extern const char* const four_bar_input_kinds[];
 extern const char* const four_bar_output_names[];
 // Closed loops: the kernels take the independent coordinates (coordinate_names); assemble
 // and the constraint kernels all 3 tree coordinates.

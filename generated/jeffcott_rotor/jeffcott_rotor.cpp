@@ -52,6 +52,7 @@ extern "C" const char* const jeffcott_rotor_coordinate_names[] = {"x", "y", null
 extern "C" const char* const jeffcott_rotor_parameter_names[] = {"m", "k", "c_n", "c_r", "Omega", nullptr};
 extern "C" const char* const jeffcott_rotor_input_names[] = {"F", nullptr};
 extern "C" const char* const jeffcott_rotor_output_names[] = {"deflection_x", "deflection_y", nullptr};
+extern "C" const char* const jeffcott_rotor_input_kinds[] = {"force", nullptr};
 extern "C" const double jeffcott_rotor_parameter_defaults[] = {10.0, 400000.0, 20.0, 40.0, 250.0, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

@@ -9,8 +9,8 @@ namespace middle_ear {
 namespace {
 const char* const coordinate_units[] = {"m", "m", "m", "rad", "rad", "rad", "m", "m", "m", "rad", "rad", "rad", "m", "m", "m", "rad", "rad", "rad", nullptr};
 const char* const parameter_units[] = {"kg", "m", "m", "m", "kg m^2", "kg m^2", "kg m^2", "kg", "m", "m", "m", "kg m^2", "kg m^2", "kg m^2", "kg", "m", "m", "m", "kg m^2", "kg m^2", "kg m^2", "kg", "kg", "m", "m", "m", "m", "m", "m", "m", "m", "m", "m", "m", "m", "m", "m", "m", "m", "m", "m", "s", "N/m", "N/m", "N/m", "N s/m", "N s/m", "N s/m", "N/m", "N/m", "N/m", "N m/rad", "N m/rad", "N m/rad", "N/m", "N/m", "N/m", "N m/rad", "N m/rad", "N m/rad", "N/m", "N/m", "N/m", "N m/rad", "N m/rad", "N m/rad", "N s/m", "N s/m", "N s/m", "N/m", "N/m", "N/m", "N m/rad", "N m/rad", "N m/rad", "N s/m", "N s/m", "N s/m", "N/m", "N/m", "N/m", "N m/rad", "N m/rad", "N m/rad", "N s/m", "N s/m", "m^2", nullptr};
-const char* const input_units[] = {"Pa", nullptr};
-const char* const output_units[] = {"m/s", "m/s", "m/s", "m", "m", "m/s", "rad/s", "rad/s", "rad/s", "N", nullptr};
+const char* const input_units[] = {"Pa", "m", "m", "m", "rad", "rad", "rad", nullptr};
+const char* const output_units[] = {"m/s", "m/s", "m/s", "m", "m", "m/s", "rad/s", "rad/s", "rad/s", "N", "m/s", "m", nullptr};
 }  // namespace
 
 std::array<double, 87> Parameters::values() const {
@@ -20,13 +20,16 @@ std::array<double, 87> Parameters::values() const {
 const mbsgen::ModelKernels& kernels() {
   static const mbsgen::ModelKernels k{
       "middle_ear", "middle_ear", "full", middle_ear_abi_version(),
-      18, 1, 10, 87, true, false, 0.0, 0.0,
+      18, 7, 12, 87, true, false, 0.0, 0.0,
       middle_ear_coordinate_names, coordinate_units, middle_ear_parameter_names, parameter_units, middle_ear_parameter_defaults,
       middle_ear_input_names, input_units, middle_ear_output_names, output_units,
       &middle_ear_operating_point, &middle_ear_linear, &middle_ear_residual, &middle_ear_mass_matrix,
-      0, false, "0.1.0", nullptr, &middle_ear_outputs,
+      0, false, "0.1.0", &middle_ear_output_terms, &middle_ear_outputs,
       0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      &middle_ear_dynamics, &middle_ear_dynamics_jacobian, nullptr};
+      &middle_ear_dynamics, &middle_ear_dynamics_jacobian, nullptr,
+      0, 0, nullptr, nullptr,
+      nullptr, nullptr, nullptr, nullptr,
+      middle_ear_input_kinds, &middle_ear_excitation};
   return k;
 }
 

@@ -107,13 +107,13 @@ struct Parameters {
 /// Generalized coordinates, as indices into y.
 enum class Coordinate : int { malleus_x = 0, malleus_y = 1, malleus_z = 2, malleus_rx = 3, malleus_ry = 4, malleus_rz = 5, incus_x = 6, incus_y = 7, incus_z = 8, incus_rx = 9, incus_ry = 10, incus_rz = 11, stapes_x = 12, stapes_y = 13, stapes_z = 14, stapes_rx = 15, stapes_ry = 16, stapes_rz = 17 };
 /// Inputs, as columns of B.
-enum class Input : int { P = 0 };
+enum class Input : int { P = 0, bone_x = 1, bone_y = 2, bone_z = 3, bone_rx = 4, bone_ry = 5, bone_rz = 6 };
 /// Outputs, as rows of C_y and C_v.
-enum class Output : int { v_stapes = 0, v_umbo = 1, v_incus_isj = 2, x_stapes = 3, x_umbo = 4, v_stapes_y = 5, omega_malleus_x = 6, omega_stapes_x = 7, omega_stapes_y = 8, F_cochlea = 9 };
+enum class Output : int { v_stapes = 0, v_umbo = 1, v_incus_isj = 2, x_stapes = 3, x_umbo = 4, v_stapes_y = 5, omega_malleus_x = 6, omega_stapes_x = 7, omega_stapes_y = 8, F_cochlea = 9, v_stapes_rel = 10, x_stapes_rel = 11 };
 
 inline constexpr int n_coordinates = 18;
-inline constexpr int n_inputs = 1;
-inline constexpr int n_outputs = 10;
+inline constexpr int n_inputs = 7;
+inline constexpr int n_outputs = 12;
 inline constexpr int n_parameters = 87;
 
 /// The kernels, names and defaults, for mbsgen::GeneratedModel and the solver command line.

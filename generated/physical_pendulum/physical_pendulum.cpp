@@ -52,6 +52,7 @@ extern "C" const char* const physical_pendulum_coordinate_names[] = {"phi", null
 extern "C" const char* const physical_pendulum_parameter_names[] = {"m", "l", "g", nullptr};
 extern "C" const char* const physical_pendulum_input_names[] = {nullptr};
 extern "C" const char* const physical_pendulum_output_names[] = {"angle", nullptr};
+extern "C" const char* const physical_pendulum_input_kinds[] = {nullptr};
 extern "C" const double physical_pendulum_parameter_defaults[] = {1.0, 1.0, 9.8100000000000005, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

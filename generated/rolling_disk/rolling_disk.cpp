@@ -37,6 +37,7 @@ extern "C" const char* const rolling_disk_coordinate_names[] = {"q1", "q2", "q3"
 extern "C" const char* const rolling_disk_parameter_names[] = {"m", "r", "g", "w", nullptr};
 extern "C" const char* const rolling_disk_input_names[] = {nullptr};
 extern "C" const char* const rolling_disk_output_names[] = {"lean", nullptr};
+extern "C" const char* const rolling_disk_input_kinds[] = {nullptr};
 extern "C" const char* const rolling_disk_speed_names[] = {"q1", "q2", "q3", nullptr};
 extern "C" const char* const rolling_disk_reduced_coordinate_names[] = {"q1", "q2", nullptr};
 extern "C" const char* const rolling_disk_reduced_part_names[] = {nullptr};

@@ -36,6 +36,8 @@ extern const char* const rolling_disk_coordinate_names[];
 extern const char* const rolling_disk_parameter_names[];
 extern const double rolling_disk_parameter_defaults[];
 extern const char* const rolling_disk_input_names[];
+// Per input "force" or "motion" (a motion input prescribes a support's motion).
+extern const char* const rolling_disk_input_kinds[];
 extern const char* const rolling_disk_output_names[];
 // Nonholonomic constraints: the linear model is E x' = A x + B u, z = C x with x the 5 coordinates and
 // the 3 independent speeds (the rates of speed_names).

@@ -52,6 +52,7 @@ extern "C" const char* const rotor_disk_coordinate_names[] = {"alpha", "beta", "
 extern "C" const char* const rotor_disk_parameter_names[] = {"m", "I_d", "I_p", "k_t", "Omega", nullptr};
 extern "C" const char* const rotor_disk_input_names[] = {"T", nullptr};
 extern "C" const char* const rotor_disk_output_names[] = {"tilt_x", "tilt_y", nullptr};
+extern "C" const char* const rotor_disk_input_kinds[] = {"force", nullptr};
 extern "C" const double rotor_disk_parameter_defaults[] = {5.0, 0.10000000000000001, 0.20000000000000001, 1000.0, 50.0, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

@@ -38,6 +38,8 @@ extern const char* const rotor_disk_coordinate_names[];
 extern const char* const rotor_disk_parameter_names[];
 extern const double rotor_disk_parameter_defaults[];
 extern const char* const rotor_disk_input_names[];
+// Per input "force" or "motion" (a motion input prescribes a support's motion).
+extern const char* const rotor_disk_input_kinds[];
 extern const char* const rotor_disk_output_names[];
 
 // Kernels (docs/generator.md): matrices column-major. Output arrays must not overlap the inputs:

@@ -52,6 +52,7 @@ extern "C" const char* const shaken_pendulum_coordinate_names[] = {"phi", nullpt
 extern "C" const char* const shaken_pendulum_parameter_names[] = {"m", "l", "g", "c", nullptr};
 extern "C" const char* const shaken_pendulum_input_names[] = {"xp", "a", nullptr};
 extern "C" const char* const shaken_pendulum_output_names[] = {"angle", "bob_x", "bob_x_rel", "pivot_x", "pivot_x_rel", "pivot_v_rel", nullptr};
+extern "C" const char* const shaken_pendulum_input_kinds[] = {"motion", "force", nullptr};
 extern "C" const double shaken_pendulum_parameter_defaults[] = {0.5, 0.80000000000000004, 9.8100000000000005, 0.050000000000000003, 0.0};
 
 // M(y, p): f×f mass matrix, column-major
@@ -75,7 +76,8 @@ extern "C" int shaken_pendulum_residual(const double* y, const double* yd, const
   (void)p;
   const double t0 = std::cos(y[0]);
   const double t1 = std::sin(y[0]);
-  r[0] = p[3]*yd[0] + p[0]*p[1]*(t1*p[2] + t0*u[1]);
+  const double t34 = p[0]*p[1]*(t1*p[2] + t0*u[1]);
+  r[0] = p[3]*yd[0] + t34;
   int status = 0;
   if (!all_finite(r, 1)) status = 1;
   return status;
@@ -105,10 +107,10 @@ extern "C" int shaken_pendulum_linear(const double* y0, const double* yd0, const
   Cy[2] = t5;
   const double t31 = (p[1]*p[1])*p[0];
   M[0] = t31;
-  const double t47 = t5*p[0];
-  B[1] = -t47;
-  const double t48 = t47*p[2];
-  K[0] = t48;
+  const double t45 = t5*p[0];
+  B[1] = -t45;
+  const double t46 = t45*p[2];
+  K[0] = t46;
   int status = 0;
   if (!all_finite(M, 1)) status = 1;
   if (!all_finite(Q, 1)) status = 1;
@@ -162,9 +164,9 @@ extern "C" int shaken_pendulum_outputs(const double* y, const double* yd, const 
   z[4] = 0.0;
   z[5] = 0.0;
   const double t1 = std::sin(y[0]);
-  const double t35 = p[1]*t1;
-  z[1] = t35;
-  z[2] = t35;
+  const double t36 = p[1]*t1;
+  z[1] = t36;
+  z[2] = t36;
   int status = 0;
   if (!all_finite(z, 6)) status = 1;
   return status;

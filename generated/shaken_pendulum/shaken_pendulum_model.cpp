@@ -11,7 +11,6 @@ const char* const coordinate_units[] = {"rad", nullptr};
 const char* const parameter_units[] = {"kg", "m", "m/s^2", "N m s/rad", nullptr};
 const char* const input_units[] = {"m", "m/s^2", nullptr};
 const char* const output_units[] = {"rad", "m", "m", "m", "m", "m/s", nullptr};
-const char* const input_kinds[] = {"motion", "force", nullptr};
 }  // namespace
 
 std::array<double, 4> Parameters::values() const {
@@ -30,7 +29,7 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr,
       0, 0, nullptr, nullptr,
       nullptr, nullptr, nullptr, nullptr,
-      input_kinds, &shaken_pendulum_excitation};
+      shaken_pendulum_input_kinds, &shaken_pendulum_excitation};
   return k;
 }
 

@@ -52,6 +52,7 @@ extern "C" const char* const sleeping_top_coordinate_names[] = {"alpha", "beta",
 extern "C" const char* const sleeping_top_parameter_names[] = {"m", "l", "I_t", "I3", "g", "w3", nullptr};
 extern "C" const char* const sleeping_top_input_names[] = {nullptr};
 extern "C" const char* const sleeping_top_output_names[] = {"tip_x", nullptr};
+extern "C" const char* const sleeping_top_input_kinds[] = {nullptr};
 extern "C" const double sleeping_top_parameter_defaults[] = {0.01, 0.040000000000000001, 0.00029999999999999997, 0.00040000000000000002, 9.8100000000000005, 10.0, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

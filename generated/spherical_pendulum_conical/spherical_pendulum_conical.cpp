@@ -52,6 +52,7 @@ extern "C" const char* const spherical_pendulum_conical_coordinate_names[] = {"t
 extern "C" const char* const spherical_pendulum_conical_parameter_names[] = {"m", "L", "g", nullptr};
 extern "C" const char* const spherical_pendulum_conical_input_names[] = {nullptr};
 extern "C" const char* const spherical_pendulum_conical_output_names[] = {"polar_angle", "bob_height", nullptr};
+extern "C" const char* const spherical_pendulum_conical_input_kinds[] = {nullptr};
 extern "C" const double spherical_pendulum_conical_parameter_defaults[] = {1.0, 1.0, 9.8100000000000005, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

@@ -52,6 +52,7 @@ extern "C" const char* const spring_chain_fixed_fixed_coordinate_names[] = {"x1"
 extern "C" const char* const spring_chain_fixed_fixed_parameter_names[] = {"m", "k", "a", nullptr};
 extern "C" const char* const spring_chain_fixed_fixed_input_names[] = {nullptr};
 extern "C" const char* const spring_chain_fixed_fixed_output_names[] = {"last_mass", nullptr};
+extern "C" const char* const spring_chain_fixed_fixed_input_kinds[] = {nullptr};
 extern "C" const double spring_chain_fixed_fixed_parameter_defaults[] = {1.0, 100.0, 1.0, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

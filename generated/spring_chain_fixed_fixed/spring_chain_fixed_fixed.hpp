@@ -38,6 +38,8 @@ extern const char* const spring_chain_fixed_fixed_coordinate_names[];
 extern const char* const spring_chain_fixed_fixed_parameter_names[];
 extern const double spring_chain_fixed_fixed_parameter_defaults[];
 extern const char* const spring_chain_fixed_fixed_input_names[];
+// Per input "force" or "motion" (a motion input prescribes a support's motion).
+extern const char* const spring_chain_fixed_fixed_input_kinds[];
 extern const char* const spring_chain_fixed_fixed_output_names[];
 
 // Kernels (docs/generator.md): matrices column-major. Output arrays must not overlap the inputs:

@@ -37,6 +37,7 @@ extern "C" const char* const whipple_benchmark_coordinate_names[] = {"x", "y", "
 extern "C" const char* const whipple_benchmark_parameter_names[] = {"w", "c", "lam", "g", "v", "rR", "mR", "IRxx", "IRyy", "xB", "zB", "mB", "IBxx", "IByy", "IBzz", "IBxz", "xH", "zH", "mH", "IHxx", "IHyy", "IHzz", "IHxz", "rF", "mF", "IFxx", "IFyy", nullptr};
 extern "C" const char* const whipple_benchmark_input_names[] = {"T_phi", "T_delta", nullptr};
 extern "C" const char* const whipple_benchmark_output_names[] = {"roll", "steer", nullptr};
+extern "C" const char* const whipple_benchmark_input_kinds[] = {"force", "force", nullptr};
 extern "C" const char* const whipple_benchmark_tree_coordinate_names[] = {"x", "y", "psi", "phi", "thetaB", "thetaR", "delta", "thetaF", nullptr};
 extern "C" const char* const whipple_benchmark_speed_names[] = {"phi", "thetaR", "delta", nullptr};
 extern "C" const char* const whipple_benchmark_reduced_coordinate_names[] = {"phi", "delta", nullptr};

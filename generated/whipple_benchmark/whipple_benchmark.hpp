@@ -43,6 +43,8 @@ extern const char* const whipple_benchmark_coordinate_names[];
 extern const char* const whipple_benchmark_parameter_names[];
 extern const double whipple_benchmark_parameter_defaults[];
 extern const char* const whipple_benchmark_input_names[];
+// Per input "force" or "motion" (a motion input prescribes a support's motion).
+extern const char* const whipple_benchmark_input_kinds[];
 extern const char* const whipple_benchmark_output_names[];
 // Closed loops: the kernels take the independent coordinates (coordinate_names); assemble
 // and the constraint kernels all 8 tree coordinates.

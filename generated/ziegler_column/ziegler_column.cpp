@@ -52,6 +52,7 @@ extern "C" const char* const ziegler_column_coordinate_names[] = {"phi1", "phi2"
 extern "C" const char* const ziegler_column_parameter_names[] = {"m", "l", "c", "b", "P", nullptr};
 extern "C" const char* const ziegler_column_input_names[] = {nullptr};
 extern "C" const char* const ziegler_column_output_names[] = {"tip_x", nullptr};
+extern "C" const char* const ziegler_column_input_kinds[] = {nullptr};
 extern "C" const double ziegler_column_parameter_defaults[] = {1.0, 1.0, 1.0, 0.0, 2.0, 0.0};
 
 // M(y, p): f×f mass matrix, column-major

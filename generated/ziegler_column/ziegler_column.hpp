@@ -40,6 +40,8 @@ extern const char* const ziegler_column_coordinate_names[];
 extern const char* const ziegler_column_parameter_names[];
 extern const double ziegler_column_parameter_defaults[];
 extern const char* const ziegler_column_input_names[];
+// Per input "force" or "motion" (a motion input prescribes a support's motion).
+extern const char* const ziegler_column_input_kinds[];
 extern const char* const ziegler_column_output_names[];
 
 // Kernels (docs/generator.md): matrices column-major. Output arrays must not overlap the inputs:

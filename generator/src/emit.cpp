@@ -819,6 +819,8 @@ std::string header_text(const Model& model, const Equations& eq, const LinearEqu
   h << "extern const char* const " << out.id << "_parameter_names[];\n";
   h << "extern const double " << out.id << "_parameter_defaults[];\n";
   h << "extern const char* const " << out.id << "_input_names[];\n";
+  h << "// Per input \"force\" or \"motion\" (a motion input prescribes a support's motion).\n";
+  h << "extern const char* const " << out.id << "_input_kinds[];\n";
   h << "extern const char* const " << out.id << "_output_names[];\n";
   if (loops)
     h << "// Closed loops: the kernels take the independent coordinates (coordinate_names); "
@@ -1508,6 +1510,9 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   c << "extern \"C\" int " << out.id << "_abi_version(void) { return " << kAbiVersion << "; }\n";
   c << names_array("coordinate_names", cn) << names_array("parameter_names", pn)
     << names_array("input_names", in) << names_array("output_names", on);
+  std::vector<std::string> kinds;
+  for (const auto& i : model.inputs()) kinds.push_back(i.motion ? "motion" : "force");
+  c << names_array("input_kinds", kinds);
   if (loops) c << names_array("tree_coordinate_names", tree);
   if (lin.descriptor) {
     std::vector<std::string> sn;

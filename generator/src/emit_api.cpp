@@ -121,9 +121,7 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     pu.push_back(p.unit);
     defaults.push_back(format_double(p.value));
   }
-  std::vector<std::string> kinds;
   for (const auto& i : model.inputs()) iu.push_back(i.unit);
-  for (const auto& i : model.inputs()) kinds.push_back(i.motion ? "motion" : "force");
   for (const auto& o : model.outputs()) ou.push_back(o.unit);
   auto kernel = [&](const std::string& name) {
     return has_kernel(code, name) ? "&" + id + "_" + name : std::string("nullptr");
@@ -135,7 +133,6 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     << id << ".hpp\"\n\nnamespace " << id << " {\n\nnamespace {\n";
   c << array("char* const", "coordinate_units", literals(cu)) << array("char* const", "parameter_units", literals(pu))
     << array("char* const", "input_units", literals(iu)) << array("char* const", "output_units", literals(ou));
-  if (model.has_motion_inputs()) c << array("char* const", "input_kinds", literals(kinds));
   c << "}  // namespace\n\n";
   c << "std::array<double, " << pm.size() << "> Parameters::values() const {\n  return {";
   for (std::size_t i = 0; i < pm.size(); ++i) c << (i ? ", " : "") << pm[i];
@@ -170,7 +167,7 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
   else if (motion)
     c << ",\n      0, 0, nullptr, nullptr,\n      nullptr, nullptr, nullptr, nullptr";
   // Prescribed motion: which inputs prescribe motion, and B1, B2, D1.
-  if (motion) c << ",\n      input_kinds, " << kernel("excitation");
+  if (motion) c << ",\n      " << id << "_input_kinds, " << kernel("excitation");
   c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"

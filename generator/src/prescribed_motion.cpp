@@ -99,11 +99,10 @@ void split_prescribed_motion(const Model& model, std::size_t bodies, Equations& 
   const std::size_t n = model.coordinates().size(), all = eq.y.size();
   PrescribedMotion& pm = eq.motion;
   pm.active = true;
-  GiNaC::exmap zero, still;
+  GiNaC::exmap zero;
   for (std::size_t c = n; c < all; ++c) {
     zero[eq.y[c]] = 0;
     zero[eq.yd[c]] = 0;
-    still[eq.yd[c]] = 0;
     pm.rates.push_back(eq.yd[c]);
   }
   // The inputs in the model's order; the motion coordinates follow the motion inputs' order.
@@ -117,11 +116,8 @@ void split_prescribed_motion(const Model& model, std::size_t bodies, Equations& 
   pm.residual.assign(eq.residual.begin(), eq.residual.begin() + static_cast<long>(n));
   pm.outputs = eq.outputs;
 
-  Program::Substitution sub(zero), held(still);
+  Program::Substitution sub(zero);
   auto at0 = [&](const ex& e) { return prog.substitute(e, sub); };
-  // k − q keeps the support's displacement u (held still, u̇ = 0), as the residual kernels take
-  // every input; the rest is at the support's reference place.
-  auto at_rest = [&](const ex& e) { return prog.substitute(e, held); };
   eq.y.resize(n);
   eq.yd.resize(n);
   if (eq.accelerations.size() > n) eq.accelerations.resize(n);
@@ -131,10 +127,10 @@ void split_prescribed_motion(const Model& model, std::size_t bodies, Equations& 
     for (auto& x : row) x = at0(x);
   }
   eq.residual.resize(n);
-  for (auto& x : eq.residual) x = at_rest(x);
+  for (auto& x : eq.residual) x = at0(x);
   if (!eq.residual_kernel.empty()) {
     eq.residual_kernel.resize(n);
-    for (auto& x : eq.residual_kernel) x = at_rest(x);
+    for (auto& x : eq.residual_kernel) x = at0(x);
   }
   for (auto& x : eq.outputs) x = at0(x);
   for (ExMatrix* J : {&eq.JT, &eq.JR}) {

@@ -608,8 +608,12 @@ Index sample_count(const SimulationOptions& o) { return static_cast<Index>(std::
 }  // namespace
 
 // Kernels generated before `outputs_general` was in the descriptor have `output_terms` but not
-// it: their `outputs` would give static loads as if dynamic, so there are no outputs then.
-bool simulates_outputs(const ModelKernels& k) { return k.outputs_general || (k.outputs && !k.output_terms); }
+// it: their `outputs` would give static loads as if dynamic, so there are no outputs then. A
+// model with motion inputs (input_kinds) has output_terms for the support's motion only (no
+// loads: Model::validate), which a simulation holds still: its `outputs` are exact.
+bool simulates_outputs(const ModelKernels& k) {
+  return k.outputs_general || (k.outputs && (!k.output_terms || k.input_kinds));
+}
 
 SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op, const SimulationOptions& o) {
   check_options(model, o);

@@ -57,6 +57,8 @@ SineResponse sine_response(const GeneratedModel& model, const OperatingPoint& op
   s.inputs.resize(static_cast<std::size_t>(k.n_inputs));
   s.inputs[static_cast<std::size_t>(input)] = InputSignal::sine(amplitude, hz);
   const SimulationResult r = simulate(model, op, s);
+  if (r.z.rows() != k.n_outputs)
+    throw Error("sine_response: model '" + std::string(k.model) + "' gives no outputs in a simulation");
 
   const Eigen::Index first = r.t.size() - 1 - static_cast<Eigen::Index>(o.fit_periods) * o.samples_per_period;
   const Eigen::Index rows = r.t.size() - first;

@@ -19,6 +19,7 @@ struct GeneratedModel {
   const char* const* parameter_names;
   const char* const* input_names;
   const char* const* output_names;
+  const char* const* input_kinds;  ///< "force" or "motion" (prescribed_motion.hpp)
   int (*mass_matrix)(const double* y, const double* p, double* M);
   int (*residual)(const double* y, const double* yd, const double* u, const double* p, double* r);
   int (*linear)(const double* y0, const double* yd0, const double* p, double* M, double* Q,
@@ -68,7 +69,8 @@ inline std::vector<std::complex<double>> quadratic_eigenvalues(const Eigen::Matr
   ::mbsgen::test::GeneratedModel {                                                          \
     #id, id##_n_coordinates, id##_n_inputs, id##_n_outputs, id##_n_parameters,              \
         id##_n_bodies, id##_at_rest != 0, id##_parameter_defaults, id##_coordinate_names,   \
-        id##_parameter_names, id##_input_names, id##_output_names, id##_mass_matrix,        \
+        id##_parameter_names, id##_input_names, id##_output_names, id##_input_kinds,         \
+        id##_mass_matrix,                                                                   \
         id##_residual, id##_linear, id##_linear_structured, id##_operating_point,           \
         id##_outputs, id##_bodies, id##_equilibrium != 0                                    \
   }
@@ -77,7 +79,8 @@ inline std::vector<std::complex<double>> quadratic_eigenvalues(const Eigen::Matr
   ::mbsgen::test::GeneratedScene {                                                          \
     {#id, id##_n_coordinates, id##_n_inputs, id##_n_outputs, id##_n_parameters,             \
      id##_n_bodies, id##_at_rest != 0, id##_parameter_defaults, id##_coordinate_names,      \
-     id##_parameter_names, id##_input_names, id##_output_names, nullptr, nullptr, nullptr,  \
+     id##_parameter_names, id##_input_names, id##_output_names, id##_input_kinds, nullptr,  \
+     nullptr, nullptr,                                                                      \
      nullptr, nullptr, nullptr, nullptr},                                                   \
         id##_D_zero != 0, id##_G_zero != 0, id##_N_zero != 0                               \
   }

@@ -195,8 +195,12 @@ Assembly assemble(const Parameters& p) {
   // Input: force (0, 0, −A P) at the umbo.
   const Vector3d f(0, 0, -p.at("A_tm"));
   const MatrixXd Pu = point_map(kMalleus, vec(p, "umbo"));
-  A.B = Pu.transpose() * f;
-  A.B_scale = Pu.colwise().norm().transpose() * f.norm();
+  // The temporal bone's motion inputs (bone conduction) reach the chain through its inertia
+  // only (B2); every bushing measures relative motion, so their columns of B are exactly zero.
+  const int P = index_of(middle_ear_input_names, kNu, "P");
+  A.B = A.B_scale = MatrixXd::Zero(kN, kNu);
+  A.B.col(P) = Pu.transpose() * f;
+  A.B_scale.col(P) = Pu.colwise().norm().transpose() * f.norm();
 
   // Outputs, by name.
   A.Cy = A.Cv = A.Cy_scale = A.Cv_scale = MatrixXd::Zero(kNr, kN);
@@ -213,6 +217,10 @@ Assembly assemble(const Parameters& p) {
   point_output("x_stapes", A.Cy, A.Cy_scale, kStapes, vec(p, "fp"), medial);
   point_output("x_umbo", A.Cy, A.Cy_scale, kMalleus, vec(p, "umbo"), medial);
   point_output("v_stapes_y", A.Cv, A.Cv_scale, kStapes, vec(p, "fp"), superior);
+  // Relative to the oval window on the temporal bone, which is still in the linear model's
+  // states (its motion enters through the inputs): the same rows as the absolute ones.
+  point_output("v_stapes_rel", A.Cv, A.Cv_scale, kStapes, vec(p, "fp"), medial);
+  point_output("x_stapes_rel", A.Cy, A.Cy_scale, kStapes, vec(p, "fp"), medial);
   // F_cochlea: minus the annular ligament's load on the footplate along z, the world-fixed
   // bushing's k_z Δz + d_z Δż (d_z with the cochlear load), = k_z x_stapes + d_z v_stapes medial.
   point_output("F_cochlea", A.Cy, A.Cy_scale, kStapes, vec(p, "fp"), medial * p.at("k_al_z"));

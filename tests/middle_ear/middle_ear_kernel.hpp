@@ -14,7 +14,7 @@
 namespace middle_ear_test {
 
 constexpr int kN = middle_ear_n_coordinates;   // 18
-constexpr int kNu = middle_ear_n_inputs;       // 1 (P)
+constexpr int kNu = middle_ear_n_inputs;       // 7 (P and the temporal bone's six motions)
 constexpr int kNr = middle_ear_n_outputs;      // outputs, in the order of the model file
 constexpr int kNp = middle_ear_n_parameters;
 

@@ -77,7 +77,9 @@ double band_edge(const std::vector<BandRow>& rows, double f, bool upper) {
 
 struct Model {
   Linear L = generated_linear(default_parameters());
-  mbsgen::LinearModel lm{L.M, L.Q, L.K, L.B, L.Cy, L.Cv, coordinate_names(), {"P"}, output_names()};
+  // The ear-canal pressure's column (the others move the temporal bone: bone conduction).
+  mbsgen::LinearModel lm{L.M, L.Q, L.K, L.B.col(index_of(middle_ear_input_names, kNu, "P")), L.Cy, L.Cv,
+                         coordinate_names(), {"P"}, output_names()};
 };
 
 // H (in (mm/s)/Pa) for the output `name` at the frequencies f_hz, by the direct (LU) method.

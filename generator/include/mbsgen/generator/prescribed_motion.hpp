@@ -15,10 +15,11 @@
 // and an output z(y, ẏ, u, u̇) adds D0 u + D1 u̇ (a point's absolute velocity moves with the
 // support). For a harmonic u = Re(û e^{iΩt}) the right-hand side is (B0 + iΩB1 − Ω²B2) û.
 //
-// The nonlinear kernels describe the support at rest: the residual and dynamics kernels take a
-// motion input's value u as the support's displacement held still (u̇ = 0), so that B0 is their
-// derivative as for a force input; the mass matrix, the bodies and the outputs are those of the
-// support in its reference place (u = 0).
+// The nonlinear kernels (mass matrix, residual, dynamics, bodies, outputs) are those of the
+// support at rest in its reference place (u = u̇ = 0; a motion input's entry of their u is not
+// read): the motion reaches the linear analyses through B, B1 and B2 only. (Keeping u in the
+// residual would cost the middle ear's residual 3,377 → 5,505 operations for a time step that
+// cannot use it: simulate refuses a moving support.)
 #pragma once
 #include "mbsgen/generator/kinematics.hpp"
 #include <functional>
