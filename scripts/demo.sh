@@ -89,9 +89,34 @@ for ext in png svg; do
   mv "$out/middle_ear_bode.$ext.tmp" "$out/middle_ear_bode.$ext"
 done
 
+# Bone conduction: the temporal bone vibrates (a motion input); the stapes velocity relative to
+# the cochlea (the oval window) per bone displacement, in (m/s)/m.
+for axis in x y z; do
+  "$solve" frf --input "bone_$axis" --output v_stapes_rel --from 100 --to 10000 --points 300 --format csv \
+    > "$out/bc_$axis.csv"
+done
+echo
+echo "== Bone conduction: |V_stapes,rel / V_bone| in dB (the ossicular, inertial pathway) =="
+for axis in x y z; do
+  awk -F, -v name="bone vibrating along $axis" 'NR > 1 {
+      f = $1; d = 20 * log(sqrt($2 * $2 + $3 * $3) / (2 * 3.141592653589793 * f)) / log(10)
+      for (i = 1; i <= 4; ++i) if (!(i in v) && f >= t[i]) v[i] = d
+      next }
+    BEGIN { t[1] = 100; t[2] = 500; t[3] = 1000; t[4] = 4000 }
+    END { printf "  %-26s 100 Hz %6.1f   500 Hz %6.1f   1 kHz %6.1f   4 kHz %6.1f\n", name, v[1], v[2], v[3], v[4] }' \
+    "$out/bc_$axis.csv"
+done
+for ext in png svg; do
+  gnuplot -e "dir='$out'; ref='$ref'; out='$out/middle_ear_bone_conduction.$ext.tmp'; fmt='$ext'" \
+    scripts/middle_ear_bone_conduction.gp
+  mv "$out/middle_ear_bone_conduction.$ext.tmp" "$out/middle_ear_bone_conduction.$ext"
+done
+
 echo
 echo "Wrote, in $(pwd)/$out:"
 echo "  middle_ear_bode.png, middle_ear_bode.svg   Bode plot: model, stapes fixation x10/x100,"
 echo "                                             reference band and measured points"
 echo "  default.csv, fixation10.csv, fixation100.csv, isj.csv   H (re, im in (m/s)/Pa), solver CSV"
+echo "  middle_ear_bone_conduction.png, .svg        bone conduction beside air conduction"
+echo "  bc_x.csv, bc_y.csv, bc_z.csv               V_stapes,rel per bone displacement ((m/s)/m)"
 echo "  modes.csv, modes_shapes.txt                 eigenvalues and mode shapes"

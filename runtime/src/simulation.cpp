@@ -364,8 +364,8 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
     for (std::size_t j = 0; j < o.inputs.size(); ++j)
       if (std::string(k.input_kinds[j]) == "motion" && !o.inputs[j].is_zero())
         throw Error("simulate: input '" + std::string(k.input_names[j]) +
-                    "' prescribes motion; a moving support is taken by the linear analyses (frf, "
-                    "static), not yet by simulate");
+                    "' prescribes motion; a moving support is taken by the frequency response (frf), "
+                    "not yet by simulate");
 }
 
 // The reason a CVode flag gives, and the time.
