@@ -35,6 +35,8 @@ inline GiNaC::exmap operating_point_values(const Model& model, const GiNaC::exma
     }
   }
   for (const auto& u : model.input_symbols()) values[u] = 0;
+  for (const auto& i : model.inputs())
+    if (i.motion) values[i.rate] = 0;  // a support at rest in its reference place
   return values;
 }
 
@@ -119,6 +121,8 @@ inline void check_derivatives_at_operating_point(const Model& model, const GiNaC
   std::vector<GiNaC::ex> state;
   for (const auto& c : model.coordinates()) state.insert(state.end(), {c.position, c.velocity});
   for (const auto& u : model.input_symbols()) state.push_back(u);
+  for (const auto& i : model.inputs())
+    if (i.motion) state.push_back(i.rate);
   auto check = [&](const GiNaC::ex& e, int order, const SourceLocation& element) {
     for (GiNaC::const_preorder_iterator i = e.preorder_begin(); i != e.preorder_end(); ++i) {
       const bool power = GiNaC::is_a<GiNaC::power>(*i);
@@ -142,6 +146,12 @@ inline void check_derivatives_at_operating_point(const Model& model, const GiNaC
       for (const auto& row : *b.rotation_matrix)
         for (const auto& x : row) check(x, 2, b.where);
   }
+  for (const auto& m : model.markers())  // a marker on the world may move with a motion input
+    if (m.body == kWorld) {
+      for (const auto& x : m.position) check(x, 2, m.where);
+      for (const auto& row : m.rotation)
+        for (const auto& x : row) check(x, 2, m.where);
+    }
   for (const auto& g : model.generalized_forces()) check(g.value, 1, g.where);
   for (const auto& a : model.applied_forces())
     for (const Vec3* v : {&a.force, &a.torque})

@@ -1336,6 +1336,11 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
         if (flags_[static_cast<std::size_t>(k)] != FrfFlag::pole) response_.col(k) += factor * z.col(k);
       }
     }
+    // Each part's selection may say the same thing again (a modal truncation): once is enough.
+    std::vector<std::string> once;
+    for (const std::string& w : warnings_)
+      if (std::find(once.begin(), once.end(), w) == once.end()) once.push_back(w);
+    warnings_ = once;
   }
   info_ = Eigen::Success;
   return *this;
