@@ -9,8 +9,8 @@ namespace shaken_pendulum {
 namespace {
 const char* const coordinate_units[] = {"rad", nullptr};
 const char* const parameter_units[] = {"kg", "m", "m/s^2", "N m s/rad", nullptr};
-const char* const input_units[] = {"m", "m/s^2", nullptr};
-const char* const output_units[] = {"rad", "m", "m", "m", "m", "m/s", nullptr};
+const char* const input_units[] = {"m", "rad", "m/s^2", nullptr};
+const char* const output_units[] = {"rad", "m", "m", "m", "m", "m/s", "m", "m", "m/s", nullptr};
 }  // namespace
 
 std::array<double, 4> Parameters::values() const {
@@ -20,7 +20,7 @@ std::array<double, 4> Parameters::values() const {
 const mbsgen::ModelKernels& kernels() {
   static const mbsgen::ModelKernels k{
       "shaken_pendulum", "shaken_pendulum", "full", shaken_pendulum_abi_version(),
-      1, 2, 6, 4, true, false, 0.0, 0.0,
+      1, 3, 9, 4, true, false, 0.0, 0.0,
       shaken_pendulum_coordinate_names, coordinate_units, shaken_pendulum_parameter_names, parameter_units, shaken_pendulum_parameter_defaults,
       shaken_pendulum_input_names, input_units, shaken_pendulum_output_names, output_units,
       &shaken_pendulum_operating_point, &shaken_pendulum_linear, &shaken_pendulum_residual, &shaken_pendulum_mass_matrix,

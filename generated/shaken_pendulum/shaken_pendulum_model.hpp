@@ -24,13 +24,13 @@ struct Parameters {
 /// Generalized coordinates, as indices into y.
 enum class Coordinate : int { phi = 0 };
 /// Inputs, as columns of B.
-enum class Input : int { xp = 0, a = 1 };
+enum class Input : int { xp = 0, tilt = 1, a = 2 };
 /// Outputs, as rows of C_y and C_v.
-enum class Output : int { angle = 0, bob_x = 1, bob_x_rel = 2, pivot_x = 3, pivot_x_rel = 4, pivot_v_rel = 5 };
+enum class Output : int { angle = 0, bob_x = 1, bob_x_rel = 2, pivot_x = 3, pivot_x_rel = 4, pivot_v_rel = 5, corner_x = 6, corner_x_rel = 7, corner_v_rel = 8 };
 
 inline constexpr int n_coordinates = 1;
-inline constexpr int n_inputs = 2;
-inline constexpr int n_outputs = 6;
+inline constexpr int n_inputs = 3;
+inline constexpr int n_outputs = 9;
 inline constexpr int n_parameters = 4;
 
 /// The kernels, names and defaults, for mbsgen::GeneratedModel and the solver command line.

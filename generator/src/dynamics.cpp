@@ -279,8 +279,6 @@ ex motion_output(const Model& model, Equations& eq, const Output& o) {
 }
 
 void derive_outputs(const Model& model, Equations& eq) {
-  Program& prog = eq.program;
-  Kinematics& kin = eq.kinematics;
   for (const auto& o : model.outputs()) {
     switch (o.kind) {
       case OutputKind::position:

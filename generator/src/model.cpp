@@ -731,7 +731,7 @@ void Model::validate() const {
         break;
       case OutputKind::expression: {
         std::set<std::string> allowed = known;
-        for (const auto& i : inputs_) allowed.erase(i.name);
+        for (const auto& i : inputs_) allowed.erase(i.name), allowed.erase(i.motion ? i.name + "_dot" : "");
         check_expr(o.expression, o.where, "an output expression", allowed);
         break;
       }

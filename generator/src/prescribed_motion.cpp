@@ -20,17 +20,13 @@ bool moves(const Marker& m, const std::vector<GiNaC::symbol>& motion) {
   return false;
 }
 
+}  // namespace
+
+// A name no body, marker, force or output of the model has (a friend of Model).
 std::string fresh_body(const Model& model, std::string base) {
-  while (model.has_marker(base) || [&] {
-    for (const auto& b : model.bodies())
-      if (b.name == base) return true;
-    return false;
-  }())
-    base += "_";
+  while (model.element_names_.count(base)) base += "_";
   return base;
 }
-
-}  // namespace
 
 // The motion inputs become coordinates after the model's own (their symbols and rates are the
 // inputs'), and leave the inputs; a marker on the world that moves with them is carried by a

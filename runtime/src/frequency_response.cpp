@@ -500,13 +500,13 @@ struct FrequencyResponse::Impl {
 
   /// The right-hand side b and the feedthrough d(rows) of one part of a moving support's
   /// excitation (FrequencyResponse::compute): B1's or B2's column and D1's or none.
-  void select_part(const Eigen::MatrixXd& Bk, const Eigen::MatrixXd* Dk, const std::vector<Index>& rows,
+  void select_part(const Eigen::MatrixXd& part_B, const Eigen::MatrixXd* part_D, const std::vector<Index>& rows,
                    Index input) {
-    if (Bk.size() != 0) b = Bk.col(input);
+    if (part_B.size() != 0) b = part_B.col(input);
     else b.setZero(n);
     feed.setZero(static_cast<Index>(rows.size()));
-    if (Dk && Dk->size() != 0)
-      for (std::size_t r = 0; r < rows.size(); ++r) feed[static_cast<Index>(r)] = (*Dk)(rows[r], input);
+    if (part_D && part_D->size() != 0)
+      for (std::size_t r = 0; r < rows.size(); ++r) feed[static_cast<Index>(r)] = (*part_D)(rows[r], input);
     bool acc = false;
     for (Index a : acc_row) acc = acc || a >= 0;
     combine = acc || (feed.array() != 0.0).any();
@@ -1318,8 +1318,18 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
   sweep(omega, m, p, response_);
   // A moving support (LinearModel::B1): the response to B(Ω) = B + iΩB1 − Ω²B2 is, by
   // linearity, that to B plus iΩ times that to B1 (with D1) minus Ω² times that to B2: two more
-  // sweeps with the same factorizations, every method unchanged.
+  // sweeps, every method unchanged (those that factor per frequency factor again: three times the
+  // cost for a motion input). A point's flag and rcond are the worst of the three sweeps (the
+  // modal method's rcond depends on the right-hand side), and a pole in any makes it NaN.
   if (model_.input_has_rates(input)) {
+    const std::vector<FrfFlag> flags = flags_;
+    const Eigen::VectorXd rcond = rcond_;
+    auto worst = [](FrfFlag a, FrfFlag b) {
+      if (a == FrfFlag::pole || b == FrfFlag::pole) return FrfFlag::pole;
+      return a == FrfFlag::ill_conditioned || b == FrfFlag::ill_conditioned ? FrfFlag::ill_conditioned : FrfFlag::ok;
+    };
+    std::vector<FrfFlag> merged = flags;
+    Eigen::VectorXd merged_rcond = rcond;
     for (int part = 1; part <= 2; ++part) {
       im.select_part(part == 1 ? model_.B1() : model_.B2(), part == 1 ? &model_.D1() : nullptr, rows, input);
       switch (m) {
@@ -1332,10 +1342,18 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
       Eigen::MatrixXcd z;
       sweep(omega, m, p, z);
       for (Index k = 0; k < omega.size(); ++k) {
+        const auto K = static_cast<std::size_t>(k);
+        merged[K] = worst(merged[K], flags_[K]);
+        merged_rcond[k] = std::min(merged_rcond[k], rcond_[k]);
         const cd factor = part == 1 ? cd(0.0, omega[k]) : cd(-omega[k] * omega[k], 0.0);
-        if (flags_[static_cast<std::size_t>(k)] != FrfFlag::pole) response_.col(k) += factor * z.col(k);
+        if (merged[K] == FrfFlag::pole)
+          response_.col(k).setConstant(cd(kNaN, kNaN));
+        else
+          response_.col(k) += factor * z.col(k);
       }
     }
+    flags_ = merged;
+    rcond_ = merged_rcond;
     // Each part's selection may say the same thing again (a modal truncation): once is enough.
     std::vector<std::string> once;
     for (const std::string& w : warnings_)

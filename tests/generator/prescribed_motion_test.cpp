@@ -17,11 +17,12 @@ using mbsgen::LinearEquations;
 using mbsgen::Model;
 using mbsgen::read_model_string;
 
-// The value of a linear-model entry with the default parameters at the operating point.
+// The value of a linear-model entry with the default parameters at the operating point (y0, ẏ0).
 double value(Equations& eq, const Model& model, const LinearEquations& lin, const ex& e) {
   GiNaC::exmap v;
   for (const auto& p : model.parameters()) v[p.symbol] = p.value;
   for (std::size_t k = 0; k < eq.y.size(); ++k) v[eq.y[k]] = lin.y0[k].subs(v);
+  for (std::size_t k = 0; k < eq.yd.size(); ++k) v[eq.yd[k]] = lin.yd0[k].subs(v);
   return GiNaC::ex_to<GiNaC::numeric>(GiNaC::evalf(eq.program.inline_all(e).subs(v))).to_double();
 }
 
@@ -102,6 +103,75 @@ forces:
   EXPECT_TRUE(near(value(ed, driven, ld, ld.B2[0][0]), -value(ef, free, lf, lf.M[1][0])));
   EXPECT_NE(value(ef, free, lf, lf.M[1][0]), 0.0);
   EXPECT_NE(value(ef, free, lf, lf.K[1][0]), 0.0);
+}
+
+// The same at a steady motion: a disk spinning at rate w0 on a gimbal (tilts a1, a2, spin s),
+// with a1 prescribed. The gyroscopic coupling I_p w0 between the tilts is in Q of the free model,
+// so B1 = −Q_(a2, s),a1 carries it, and B = −K, B2 = −M as before.
+TEST(PrescribedMotion, APrescribedCoordinateAtASteadyMotionCarriesTheGyroscopicCoupling) {
+  auto model_text = [](bool prescribed) {
+    return std::string("model: gimbal\nparameters: {It: 0.3, Ip: 0.5, k: 40, c: 0.2, w0: 30}\n") +
+           (prescribed ? "coordinates: [a2, s]\ninputs: [{name: a1, kind: motion}]\n" : "coordinates: [a1, a2, s]\n") +
+           R"(bodies:
+  - {name: disk, rotation: [{x: a1}, {y: a2}, {z: s}], mass: 2, inertia: {xx: It, yy: It, zz: Ip}}
+forces:
+  - {type: generalized, coordinate: a2, value: -k*a2 - c*a2_dot - k*a1}
+operating_point:
+  type: given
+  velocity: {s: w0}
+)";
+  };
+  const Model free = read_model_string(model_text(false), "free.yaml");
+  const Model driven = read_model_string(model_text(true), "driven.yaml");
+  Equations ef = mbsgen::derive(free), ed = mbsgen::derive(driven);
+  LinearEquations lf = mbsgen::linearize(ef), ld = mbsgen::linearize(ed);
+  ASSERT_FALSE(ld.at_rest);
+  auto near = [](double a, double b) { return std::abs(a - b) <= 1e-14 * std::max({std::abs(a), std::abs(b), 1e-300}); };
+  for (std::size_t i = 0; i < 2; ++i) {  // driven rows a2, s = free rows 1, 2
+    SCOPED_TRACE(i);
+    EXPECT_TRUE(near(value(ed, driven, ld, ld.B[i][0]), -value(ef, free, lf, lf.K[i + 1][0])));
+    EXPECT_TRUE(near(value(ed, driven, ld, ld.B1[i][0]), -value(ef, free, lf, lf.Q[i + 1][0])));
+    EXPECT_TRUE(near(value(ed, driven, ld, ld.B2[i][0]), -value(ef, free, lf, lf.M[i + 1][0])));
+    for (std::size_t j = 0; j < 2; ++j) {
+      EXPECT_TRUE(near(value(ed, driven, ld, ld.Q[i][j]), value(ef, free, lf, lf.Q[i + 1][j + 1])));
+      EXPECT_TRUE(near(value(ed, driven, ld, ld.K[i][j]), value(ef, free, lf, lf.K[i + 1][j + 1])));
+    }
+  }
+  // The gyroscopic coupling: Q_(a2, a1) = ±Ip w0 = ±15 (the sign depends on the axes' order).
+  EXPECT_EQ(std::abs(value(ef, free, lf, lf.Q[1][0])), 15.0);
+}
+
+// A marker on the world that turns with a motion input (a rotating anchor): through a bushing's
+// torsional spring and damper about z, B = k_r and B1 = d_r on the rotor's angle.
+TEST(PrescribedMotion, ATurningMarkerOnTheWorldExcitesThroughItsRotation) {
+  const Model model = read_model_string(R"(model: turning_anchor
+parameters: {J: 0.01, kr: 3, dr: 0.02}
+coordinates: [phi]
+inputs: [{name: r, kind: motion}]
+markers:
+  - {name: anchor, rotation: [{z: r}]}
+bodies:
+  - {name: rotor, rotation: [{z: phi}], mass: 1, inertia: {xx: 0.006, yy: 0.006, zz: J}, markers: [{name: hub}]}
+forces:
+  - {type: bushing, between: [anchor, hub], stiffness: {rotation: [0, 0, kr]}, damping: {rotation: [0, 0, dr]}}
+)",
+                                        "turning_anchor.yaml");
+  Equations eq = mbsgen::derive(model);
+  LinearEquations lin = mbsgen::linearize(eq);
+  EXPECT_EQ(value(eq, model, lin, lin.K[0][0]), 3.0);
+  EXPECT_EQ(value(eq, model, lin, lin.B[0][0]), 3.0);
+  EXPECT_EQ(value(eq, model, lin, lin.B1[0][0]), 0.02);
+  EXPECT_TRUE(lin.B2[0][0].is_zero()) << "the anchor has no mass";
+}
+
+// A carrier body's name never clashes with an element of the model.
+TEST(PrescribedMotion, TheCarrierOfAMovingMarkerTakesAFreeName) {
+  std::string text = kOscillatorOnAMarker;
+  text.replace(text.find("outputs:\n"), 9, "outputs:\n  - {name: support_of_ground, type: coordinate, coordinate: x}\n");
+  const Model model = read_model_string(text, "oscillator_on_a_marker.yaml");
+  Equations eq = mbsgen::derive(model);
+  LinearEquations lin = mbsgen::linearize(eq);
+  EXPECT_EQ(value(eq, model, lin, lin.B[0][0]), 800.0);
 }
 
 }  // namespace

@@ -388,6 +388,8 @@ Model with_joint_probes(const Model& model, const std::vector<std::string>& bodi
 Model with_motion_coordinates(const Model& model);
 /// Sets the dropped motion inputs of a scene (and their rates) to 0 in the kinematics (scene.hpp).
 void hold_dropped_supports(Model& m, const GiNaC::exmap& dropped);
+/// `base`, with '_' appended until no element (body, marker, force, output) has that name.
+std::string fresh_body(const Model& model, std::string base);
 
 /// A multibody model. Add parameters, coordinates and inputs first (they create the symbols that
 /// expressions use), then bodies, markers, forces and outputs. `validate()` checks the whole.
@@ -504,6 +506,7 @@ class Model {
   friend Model apply_scene(const Model& model, const std::string& scene);
   friend Model with_joint_probes(const Model& model, const std::vector<std::string>& bodies);
   friend Model with_motion_coordinates(const Model& model);
+  friend std::string fresh_body(const Model& model, std::string base);
   friend void hold_dropped_supports(Model& m, const GiNaC::exmap& dropped);
 
   void check_new_symbol(const std::string& name, const SourceLocation& where);

@@ -20,6 +20,11 @@
 // read): the motion reaches the linear analyses through B, B1 and B2 only. (Keeping u in the
 // residual would cost the middle ear's residual 3,377 → 5,505 operations for a time step that
 // cannot use it: simulate refuses a moving support.)
+//
+// After derive(), Equations::model is the model as written, where a moving marker is still on the
+// world: Kinematics::marker_position would give its position with u free and marker_velocity no
+// velocity. The stages after derive() that read markers (loop closure, reactions, rolling) are
+// therefore refused together with motion inputs (Model::validate).
 #pragma once
 #include "mbsgen/generator/kinematics.hpp"
 #include <functional>
