@@ -197,10 +197,10 @@ Assembly assemble(const Parameters& p) {
   const MatrixXd Pu = point_map(kMalleus, vec(p, "umbo"));
   // The temporal bone's motion inputs (bone conduction) reach the chain through its inertia
   // only (B2); every bushing measures relative motion, so their columns of B are exactly zero.
-  const int P = index_of(middle_ear_input_names, kNu, "P");
+  const int pressure = index_of(middle_ear_input_names, kNu, "P");
   A.B = A.B_scale = MatrixXd::Zero(kN, kNu);
-  A.B.col(P) = Pu.transpose() * f;
-  A.B_scale.col(P) = Pu.colwise().norm().transpose() * f.norm();
+  A.B.col(pressure) = Pu.transpose() * f;
+  A.B_scale.col(pressure) = Pu.colwise().norm().transpose() * f.norm();
 
   // Outputs, by name.
   A.Cy = A.Cv = A.Cy_scale = A.Cv_scale = MatrixXd::Zero(kNr, kN);
