@@ -234,4 +234,25 @@ Kinematics compute_kinematics(const Model& model, Program& program) {
   return kin;
 }
 
+void restrict_kinematics(Kinematics& kin, std::size_t n, const std::function<GiNaC::ex(const GiNaC::ex&)>& f) {
+  auto vec = [&](Vec3& v) {
+    for (auto& x : v) x = f(x);
+  };
+  auto mat = [&](Mat3& A) {
+    for (auto& row : A) vec(row);
+  };
+  for (BodyKinematics& b : kin.bodies) {
+    mat(b.S), vec(b.r), vec(b.com), mat(b.I_com);
+    vec(b.V.w), vec(b.V.v), vec(b.bias.w), vec(b.bias.v);
+    b.inertia.m = f(b.inertia.m), vec(b.inertia.h), mat(b.inertia.J);
+    std::vector<JointColumn> kept;
+    for (JointColumn col : b.columns)
+      if (static_cast<std::size_t>(col.coordinate) < n) {
+        vec(col.phi.w), vec(col.phi.v);
+        kept.push_back(col);
+      }
+    b.columns = kept;
+  }
+}
+
 }  // namespace mbsgen

@@ -61,35 +61,6 @@ Model with_motion_coordinates(const Model& model) {
   return moving;
 }
 
-namespace {
-
-// Everything of the tree's kinematics at the support's rest (u = u̇ = 0), without the columns of
-// the motion coordinates and the carrier bodies of moving world markers.
-void kinematics_at_rest(Kinematics& kin, std::size_t n, std::size_t bodies,
-                        const std::function<ex(const ex&)>& at0) {
-  auto vec = [&](Vec3& v) {
-    for (auto& x : v) x = at0(x);
-  };
-  auto mat = [&](Mat3& A) {
-    for (auto& row : A) vec(row);
-  };
-  kin.bodies.resize(bodies);
-  for (BodyKinematics& b : kin.bodies) {
-    mat(b.S), vec(b.r), vec(b.com), mat(b.I_com);
-    vec(b.V.w), vec(b.V.v), vec(b.bias.w), vec(b.bias.v);
-    b.inertia.m = at0(b.inertia.m), vec(b.inertia.h), mat(b.inertia.J);
-    std::vector<JointColumn> kept;
-    for (JointColumn col : b.columns)
-      if (static_cast<std::size_t>(col.coordinate) < n) {
-        vec(col.phi.w), vec(col.phi.v);
-        kept.push_back(col);
-      }
-    b.columns = kept;
-  }
-}
-
-}  // namespace
-
 void split_prescribed_motion(const Model& model, std::size_t bodies, Equations& eq) {
   Program& prog = eq.program;
   const std::size_t n = model.coordinates().size(), all = eq.y.size();
@@ -136,7 +107,10 @@ void split_prescribed_motion(const Model& model, std::size_t bodies, Equations& 
       for (auto& x : row) x = at0(x);
     }
   }
-  kinematics_at_rest(eq.kinematics, n, bodies, at0);
+  // The kinematics at the support's rest, without the motion coordinates' columns and the
+  // carrier bodies of moving markers on the world (appended after the model's).
+  eq.kinematics.bodies.resize(bodies);
+  restrict_kinematics(eq.kinematics, n, at0);
 }
 
 }  // namespace mbsgen

@@ -106,24 +106,7 @@ void strip_joint_probes(const Model& model, Equations& eq, JointProbes& probes) 
       row.resize(n);
       for (auto& x : row) x = at0(x);
     }
-  auto vec = [&](Vec3& v) {
-    for (auto& x : v) x = at0(x);
-  };
-  auto mat = [&](Mat3& A) {
-    for (auto& row : A) vec(row);
-  };
-  for (BodyKinematics& b : eq.kinematics.bodies) {
-    mat(b.S), vec(b.r), vec(b.com), mat(b.I_com);
-    vec(b.V.w), vec(b.V.v), vec(b.bias.w), vec(b.bias.v);
-    b.inertia.m = at0(b.inertia.m), vec(b.inertia.h), mat(b.inertia.J);
-    std::vector<JointColumn> kept;
-    for (JointColumn col : b.columns)
-      if (static_cast<std::size_t>(col.coordinate) < n) {
-        vec(col.phi.w), vec(col.phi.v);
-        kept.push_back(col);
-      }
-    b.columns = kept;
-  }
+  restrict_kinematics(eq.kinematics, n, at0);
 }
 
 namespace {

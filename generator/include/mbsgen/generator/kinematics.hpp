@@ -13,6 +13,7 @@
 #include "mbsgen/generator/model.hpp"
 #include "mbsgen/generator/program.hpp"
 
+#include <functional>
 #include <vector>
 
 namespace mbsgen {
@@ -63,6 +64,10 @@ struct Kinematics {
   bool is_ancestor_or_self(int a, int b) const;
 };
 
+/// Applies `f` to every expression of the bodies' kinematics and drops the joint columns of the
+/// coordinates from `n` on: the kinematics of the first n coordinates with the others fixed, as
+/// the joint probes of reactions.hpp and the prescribed motion of prescribed_motion.hpp leave it.
+void restrict_kinematics(Kinematics& kin, std::size_t n, const std::function<GiNaC::ex(const GiNaC::ex&)>& f);
 /// Builds the kinematics of every body; registers nothing (the Program's variables are the
 /// model's coordinates, rates, inputs and parameters, registered by the caller).
 Kinematics compute_kinematics(const Model& model, Program& program);
