@@ -56,13 +56,21 @@ int run_modes(const Common& c, bool all, std::ostream& out) {
 }
 
 struct FrfArgs {
-  std::string B, C, Cv, Ca, D, method = "auto", spacing = "log", on_pole = "flag";
+  std::string B, C, Cv, Ca, D, B1, B2, D1, method = "auto", spacing = "log", on_pole = "flag";
   long input = 1, output = 1, points = 200;
   double from = 1.0, to = 1000.0;
 };
 
-int run_frf(const Common& c, const FrfArgs& a, std::ostream& out, std::ostream& err) {
+// The model of `frf`, with a moving support's B1, B2, D1 when given (prescribed motion).
+LinearModel load_frf(const Common& c, const FrfArgs& a) {
   const LinearModel model = load(c, a.B, a.C, a.Cv, a.Ca, a.D);
+  if (a.B1.empty() && a.B2.empty() && a.D1.empty()) return model;
+  auto read = [](const std::string& f) { return f.empty() ? Eigen::MatrixXd() : read_matrix_market(f); };
+  return model.with_input_rates(read(a.B1), read(a.B2), read(a.D1));
+}
+
+int run_frf(const Common& c, const FrfArgs& a, std::ostream& out, std::ostream& err) {
+  const LinearModel model = load_frf(c, a);
   // Out of the model's range: a usage error (exit status 2), like an unknown name for a solver.
   if (a.input < 1 || a.input > model.num_inputs())
     throw NameError("--input " + std::to_string(a.input) + " out of range 1.." +
@@ -118,6 +126,9 @@ int linear_main(int argc, char** argv, std::ostream& out, std::ostream& err) try
 ;
   frf->add_option("--Ca", a.Ca, "acceleration output matrix C_a (p x f); default 0");
   frf->add_option("--D", a.D, "feedthrough matrix D (p x m), z += D u; default 0");
+  frf->add_option("--B1", a.B1, "a moving support's rate matrix B1 (f x m), h += B1 u'; default 0");
+  frf->add_option("--B2", a.B2, "a moving support's acceleration matrix B2 (f x m), h += B2 u''; default 0");
+  frf->add_option("--D1", a.D1, "feedthrough of the input's rate D1 (p x m), z += D1 u'; default 0");
   frf->add_option("--input", a.input, "input: column of B, 1-based")->check(CLI::Range(1L, 1000000000L));
   frf->add_option("--output", a.output, "output: row of C, 1-based")->check(CLI::Range(1L, 1000000000L));
   frf->add_option("--from", a.from, "first frequency [Hz]")->check(frequency_hz());
