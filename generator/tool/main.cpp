@@ -73,7 +73,7 @@ int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& sce
   std::cout << "\n";
   print_loops(model, eq.loops);
   std::cout << "inputs (" << model.inputs().size() << "):";
-  for (const auto& i : model.inputs()) std::cout << " " << i.name;
+  for (const auto& i : model.inputs()) std::cout << " " << i.name << (i.motion ? " (motion)" : "");
   std::cout << "\noutputs (" << model.outputs().size() << "):";
   for (const auto& o : model.outputs()) std::cout << " " << o.name;
   std::cout << "\nparameters (" << model.parameters().size() << ")\n";

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <complex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/generated_model.hpp"
 #include "mbsgen/runtime/simulation.hpp"
+#include "mbsgen/runtime/solver_cli.hpp"
 #include "middle_ear.hpp"
 #include "middle_ear_model.hpp"
 #include "shaken_pendulum_model.hpp"
@@ -203,6 +205,19 @@ TEST(BaseExcitation, SimulateRefusesAMovingSupport) {
   o.inputs = {mbsgen::InputSignal(), mbsgen::InputSignal::step(1.0)};
   const mbsgen::SimulationResult r = mbsgen::simulate(model, model.operating_point(), o);
   EXPECT_GT(r.y(0, r.t.size() - 1), 0.0) << "the force input moves the mass";
+}
+
+// The solver's `info` says which inputs prescribe motion (the manifest's `kind`).
+TEST(BaseExcitation, InfoSaysWhichInputsMove) {
+  std::vector<std::string> args = {"base_excited_oscillator-solve", "info"};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  std::ostringstream out, err;
+  ASSERT_EQ(mbsgen::cli::solver_main(base_excited_oscillator::kernels(), static_cast<int>(argv.size()), argv.data(),
+                                     out, err),
+            0)
+      << err.str();
+  EXPECT_NE(out.str().find("inputs (2): xb [m, motion] F [N]\n"), std::string::npos) << out.str();
 }
 
 // Bone conduction of the middle ear (models/middle_ear): the temporal bone moves the chain
