@@ -389,6 +389,28 @@ Equations derive_tree(const Model& model, const Model& original, const DeriveOpt
 
 }  // namespace
 
+void restrict_equations(Equations& eq, std::size_t n, const std::function<ex(const ex&)>& f) {
+  eq.y.resize(n);
+  eq.yd.resize(n);
+  if (eq.accelerations.size() > n) eq.accelerations.resize(n);
+  eq.M.resize(n);
+  for (auto& row : eq.M) {
+    row.resize(n);
+    for (auto& x : row) x = f(x);
+  }
+  for (std::vector<ex>* v : {&eq.residual, &eq.residual_kernel}) {
+    if (v->size() > n) v->resize(n);
+    for (auto& x : *v) x = f(x);
+  }
+  for (auto& x : eq.outputs) x = f(x);
+  for (ExMatrix* J : {&eq.JT, &eq.JR})
+    for (auto& row : *J) {
+      row.resize(n);
+      for (auto& x : row) x = f(x);
+    }
+  restrict_kinematics(eq.kinematics, n, f);
+}
+
 Equations derive(const Model& model, const DeriveOptions& options) {
   model.validate();
   // Joint loads: the tree with probes in the asked joints, then the probes removed (reactions.hpp).

@@ -84,33 +84,11 @@ void split_prescribed_motion(const Model& model, std::size_t bodies, Equations& 
   pm.outputs = eq.outputs;
 
   Program::Substitution sub(zero);
-  auto at0 = [&](const ex& e) { return prog.substitute(e, sub); };
-  eq.y.resize(n);
-  eq.yd.resize(n);
-  if (eq.accelerations.size() > n) eq.accelerations.resize(n);
-  eq.M.resize(n);
-  for (auto& row : eq.M) {
-    row.resize(n);
-    for (auto& x : row) x = at0(x);
-  }
-  eq.residual.resize(n);
-  for (auto& x : eq.residual) x = at0(x);
-  if (!eq.residual_kernel.empty()) {
-    eq.residual_kernel.resize(n);
-    for (auto& x : eq.residual_kernel) x = at0(x);
-  }
-  for (auto& x : eq.outputs) x = at0(x);
-  for (ExMatrix* J : {&eq.JT, &eq.JR}) {
-    J->resize(3 * bodies);
-    for (auto& row : *J) {
-      row.resize(n);
-      for (auto& x : row) x = at0(x);
-    }
-  }
-  // The kinematics at the support's rest, without the motion coordinates' columns and the
-  // carrier bodies of moving markers on the world (appended after the model's).
+  // The equations at the support's rest, without the motion coordinates and the carrier bodies
+  // of moving markers on the world (appended after the model's).
+  for (ExMatrix* J : {&eq.JT, &eq.JR}) J->resize(3 * bodies);
   eq.kinematics.bodies.resize(bodies);
-  restrict_kinematics(eq.kinematics, n, at0);
+  restrict_equations(eq, n, [&](const ex& e) { return prog.substitute(e, sub); });
 }
 
 }  // namespace mbsgen

@@ -91,22 +91,7 @@ void strip_joint_probes(const Model& model, Equations& eq, JointProbes& probes) 
   probes.symbols = probe_y;
   for (std::size_t k = 0; k < probes.bodies.size(); ++k) probes.first.push_back(n + 6 * k);
 
-  eq.y.resize(n);
-  eq.yd.resize(n);
-  eq.M.resize(n);
-  for (auto& row : eq.M) {
-    row.resize(n);
-    for (auto& x : row) x = at0(x);
-  }
-  eq.residual.resize(n);
-  for (auto& x : eq.residual) x = at0(x);
-  for (auto& x : eq.outputs) x = at0(x);
-  for (ExMatrix* J : {&eq.JT, &eq.JR})
-    for (auto& row : *J) {
-      row.resize(n);
-      for (auto& x : row) x = at0(x);
-    }
-  restrict_kinematics(eq.kinematics, n, at0);
+  restrict_equations(eq, n, at0);
 }
 
 namespace {

@@ -360,12 +360,11 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
                          std::to_string(k.n_inputs) + " inputs");
   // The kernels hold a moving support at rest (prescribed_motion.hpp): a signal on a motion
   // input would be silently lost.
-  if (k.input_kinds)
-    for (std::size_t j = 0; j < o.inputs.size(); ++j)
-      if (std::string(k.input_kinds[j]) == "motion" && !o.inputs[j].is_zero())
-        throw Error("simulate: input '" + std::string(k.input_names[j]) +
-                    "' prescribes motion; a moving support is taken by the frequency response (frf), "
-                    "not yet by simulate");
+  for (std::size_t j = 0; j < o.inputs.size(); ++j)
+    if (is_motion_input(k, static_cast<int>(j)) && !o.inputs[j].is_zero())
+      throw Error("simulate: input '" + std::string(k.input_names[j]) +
+                  "' prescribes motion; a moving support is taken by the frequency response (frf), "
+                  "not yet by simulate");
 }
 
 // The reason a CVode flag gives, and the time.

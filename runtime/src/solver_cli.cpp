@@ -61,8 +61,8 @@ int run_info(const ModelKernels& k, const Options& o, std::ostream& out) {
   for (int i = 0; i < k.n_coordinates; ++i) out << " " << k.coordinate_names[i];
   out << "\ninputs (" << k.n_inputs << "):";
   for (int i = 0; i < k.n_inputs; ++i) {
-    const bool motion = k.input_kinds && std::string(k.input_kinds[i]) == "motion";
-    out << " " << k.input_names[i] << " [" << unit_or(k.input_units, i, "-") << (motion ? ", motion" : "") << "]";
+    out << " " << k.input_names[i] << " [" << unit_or(k.input_units, i, "-")
+        << (is_motion_input(k, i) ? ", motion" : "") << "]";
   }
   out << "\noutputs (" << k.n_outputs << "):";
   for (int i = 0; i < k.n_outputs; ++i) out << " " << k.output_names[i] << " [" << unit_or(k.output_units, i, "-") << "]";

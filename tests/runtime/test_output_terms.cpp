@@ -391,6 +391,37 @@ TEST(GeneratedModelOutputTerms, SolverMatricesListCaAndDOnlyWhenPresent) {
   EXPECT_NE(with_terms.find(",\n\"D\":[[0],[0],[1]]}"), std::string::npos) << with_terms;
 }
 
+namespace {
+
+// `mbsgen linear ARGS` in process: its status, standard output and standard error.
+int linear_cli(std::vector<std::string> args, std::string& out_text, std::string& err_text) {
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  std::ostringstream out, err;
+  const int rc = mbsgen::cli::linear_main(static_cast<int>(argv.size()), argv.data(), out, err);
+  out_text = out.str();
+  err_text = err.str();
+  return rc;
+}
+
+// The rows (frequency, re + i im) of `frf --format csv`.
+std::vector<std::pair<double, cd>> frf_csv(const std::string& csv) {
+  std::vector<std::pair<double, cd>> v;
+  std::istringstream s(csv);
+  std::string line;
+  std::getline(s, line);  // header
+  while (std::getline(s, line)) {
+    double f = 0, re = 0, im = 0;
+    char c1 = 0, c2 = 0;
+    std::istringstream l(line);
+    l >> f >> c1 >> re >> c2 >> im;
+    v.emplace_back(f, cd(re, im));
+  }
+  return v;
+}
+
+}  // namespace
+
 // `mbsgen linear frf --Ca --D`: the sizes are checked against C and B with the library's message
 // (status 1, bad data); the two routes to the wall force agree (the docs/cli.md example shows the
 // table; here to rounding).
@@ -402,13 +433,7 @@ TEST(MbsgenLinearCli, AccelerationAndFeedthroughOptions) {
                                      data + "Cwall.mtx", "--Cv", data + "Cvwall.mtx", "--format", "csv",
                                      "--points", "7"};
     args.insert(args.end(), more.begin(), more.end());
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    std::ostringstream out, err;
-    const int rc = mbsgen::cli::linear_main(static_cast<int>(argv.size()), argv.data(), out, err);
-    out_text = out.str();
-    err_text = err.str();
-    return rc;
+    return linear_cli(args, out_text, err_text);
   };
   std::string out, err;
   EXPECT_EQ(run({"--Ca", data + "M.mtx"}, out, err), 1);
@@ -422,16 +447,7 @@ TEST(MbsgenLinearCli, AccelerationAndFeedthroughOptions) {
   ASSERT_EQ(run({"--Ca", data + "Cawall.mtx", "--D", data + "Dwall.mtx", "--output", "2"}, out2, err), 0) << err;
   auto re_im = [](const std::string& csv) {
     std::vector<cd> v;
-    std::istringstream s(csv);
-    std::string line;
-    std::getline(s, line);  // header
-    while (std::getline(s, line)) {
-      double f = 0, re = 0, im = 0;
-      char c1 = 0, c2 = 0;
-      std::istringstream l(line);
-      l >> f >> c1 >> re >> c2 >> im;
-      v.emplace_back(re, im);
-    }
+    for (const auto& row : frf_csv(csv)) v.push_back(row.second);
     return v;
   };
   const auto z1 = re_im(out1), z2 = re_im(out2);
@@ -463,31 +479,11 @@ TEST(MbsgenLinearCli, MovingSupportOptions) {
                                      scalar("Q", c), "--B", scalar("B", k), "--B1", scalar("B1", c),
                                      "--format", "csv", "--from", "0.5", "--to", "50", "--points", "9"};
     args.insert(args.end(), more.begin(), more.end());
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    std::ostringstream out, err;
-    const int rc = mbsgen::cli::linear_main(static_cast<int>(argv.size()), argv.data(), out, err);
-    out_text = out.str();
-    err_text = err.str();
-    return rc;
-  };
-  auto rows = [](const std::string& csv) {
-    std::vector<std::pair<double, cd>> v;
-    std::istringstream s(csv);
-    std::string line;
-    std::getline(s, line);  // header
-    while (std::getline(s, line)) {
-      double f = 0, re = 0, im = 0;
-      char c1 = 0, c2 = 0;
-      std::istringstream l(line);
-      l >> f >> c1 >> re >> c2 >> im;
-      v.emplace_back(f, cd(re, im));
-    }
-    return v;
+    return linear_cli(args, out_text, err_text);
   };
   std::string out, err;
   ASSERT_EQ(run({}, out, err), 0) << err;
-  const auto absolute = rows(out);
+  const auto absolute = frf_csv(out);
   ASSERT_EQ(absolute.size(), 9u);
   for (const auto& [f, z] : absolute) {
     const double w = 2 * 3.141592653589793 * f;
@@ -495,7 +491,7 @@ TEST(MbsgenLinearCli, MovingSupportOptions) {
     EXPECT_LE(std::abs(z - T), 1e-12 * std::abs(T)) << f << " Hz";
   }
   ASSERT_EQ(run({"--D", scalar("D", -1)}, out, err), 0) << err;
-  const auto relative = rows(out);
+  const auto relative = frf_csv(out);
   ASSERT_EQ(relative.size(), 9u);
   for (const auto& [f, z] : relative) {
     const double w = 2 * 3.141592653589793 * f;

@@ -79,6 +79,11 @@ struct DeriveOptions {
   Projection projection = Projection::composite;
 };
 
+/// Keeps the equations of the first n coordinates, with `f` applied to every expression (the
+/// others fixed by it): y, ẏ, the accelerations, M, k − q (and its kernel form), the outputs,
+/// the body Jacobians' columns and the kinematics (restrict_kinematics). For the joint probes of
+/// reactions.hpp and the prescribed motion of prescribed_motion.hpp.
+void restrict_equations(Equations& eq, std::size_t n, const std::function<GiNaC::ex(const GiNaC::ex&)>& f);
 /// Derives the equations of a validated model. When model.inertial_velocity_terms() is false
 /// (a scene that drops them), k(y, ẏ) has no velocity-quadratic inertia terms: the residual is
 /// then exact at ẏ = 0 only.

@@ -117,6 +117,11 @@ struct ModelKernels {
                     double* D1) = nullptr;
 };
 
+/// True when input j of the kernels prescribes motion (input_kinds, prescribed motion).
+inline bool is_motion_input(const ModelKernels& k, int j) {
+  return k.input_kinds && k.input_kinds[j] && std::string(k.input_kinds[j]) == "motion";
+}
+
 /// The first n entries of a kernel name array (null entries become "").
 std::vector<std::string> name_list(const char* const* names, int n);
 
