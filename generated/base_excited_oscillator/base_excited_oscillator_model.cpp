@@ -29,7 +29,8 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr,
       0, 0, nullptr, nullptr,
       nullptr, nullptr, nullptr, nullptr,
-      base_excited_oscillator_input_kinds, &base_excited_oscillator_excitation};
+      base_excited_oscillator_input_kinds, &base_excited_oscillator_excitation,
+      base_excited_oscillator_n_sensitivity_parameters, base_excited_oscillator_sensitivity_parameter_names, &base_excited_oscillator_sensitivity, nullptr};
   return k;
 }
 

@@ -26,7 +26,11 @@ const mbsgen::ModelKernels& kernels() {
       &chain3_sympy_operating_point, &chain3_sympy_linear, &chain3_sympy_residual, &chain3_sympy_mass_matrix,
       0, false, "0.1.0", nullptr, &chain3_sympy_outputs,
       0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      &chain3_sympy_dynamics, &chain3_sympy_dynamics_jacobian, nullptr};
+      &chain3_sympy_dynamics, &chain3_sympy_dynamics_jacobian, nullptr,
+      0, 0, nullptr, nullptr,
+      nullptr, nullptr, nullptr, nullptr,
+      nullptr, nullptr,
+      chain3_sympy_n_sensitivity_parameters, chain3_sympy_sensitivity_parameter_names, &chain3_sympy_sensitivity, nullptr};
   return k;
 }
 

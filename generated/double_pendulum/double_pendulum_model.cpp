@@ -26,7 +26,11 @@ const mbsgen::ModelKernels& kernels() {
       &double_pendulum_operating_point, &double_pendulum_linear, &double_pendulum_residual, &double_pendulum_mass_matrix,
       0, false, "0.1.0", nullptr, &double_pendulum_outputs,
       0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      &double_pendulum_dynamics, &double_pendulum_dynamics_jacobian, nullptr};
+      &double_pendulum_dynamics, &double_pendulum_dynamics_jacobian, nullptr,
+      0, 0, nullptr, nullptr,
+      nullptr, nullptr, nullptr, nullptr,
+      nullptr, nullptr,
+      double_pendulum_n_sensitivity_parameters, double_pendulum_sensitivity_parameter_names, &double_pendulum_sensitivity, nullptr};
   return k;
 }
 

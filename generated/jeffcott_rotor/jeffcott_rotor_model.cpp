@@ -26,7 +26,11 @@ const mbsgen::ModelKernels& kernels() {
       &jeffcott_rotor_operating_point, &jeffcott_rotor_linear, &jeffcott_rotor_residual, &jeffcott_rotor_mass_matrix,
       0, false, "0.1.0", nullptr, &jeffcott_rotor_outputs,
       0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      &jeffcott_rotor_dynamics, &jeffcott_rotor_dynamics_jacobian, nullptr};
+      &jeffcott_rotor_dynamics, &jeffcott_rotor_dynamics_jacobian, nullptr,
+      0, 0, nullptr, nullptr,
+      nullptr, nullptr, nullptr, nullptr,
+      nullptr, nullptr,
+      jeffcott_rotor_n_sensitivity_parameters, jeffcott_rotor_sensitivity_parameter_names, &jeffcott_rotor_sensitivity, nullptr};
   return k;
 }
 

@@ -24,7 +24,13 @@ const mbsgen::ModelKernels& kernels() {
       rotor_disk_coordinate_names, coordinate_units, rotor_disk_parameter_names, parameter_units, rotor_disk_parameter_defaults,
       rotor_disk_input_names, input_units, rotor_disk_output_names, output_units,
       &rotor_disk_operating_point, &rotor_disk_linear, &rotor_disk_residual, &rotor_disk_mass_matrix,
-      0, false, "0.1.0", nullptr, &rotor_disk_outputs};
+      0, false, "0.1.0", nullptr, &rotor_disk_outputs,
+      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
+      nullptr, nullptr, nullptr,
+      0, 0, nullptr, nullptr,
+      nullptr, nullptr, nullptr, nullptr,
+      nullptr, nullptr,
+      rotor_disk_n_sensitivity_parameters, rotor_disk_sensitivity_parameter_names, &rotor_disk_sensitivity, &rotor_disk_operating_point_sensitivity};
   return k;
 }
 

@@ -24,7 +24,13 @@ const mbsgen::ModelKernels& kernels() {
       spring_chain_fixed_fixed_coordinate_names, coordinate_units, spring_chain_fixed_fixed_parameter_names, parameter_units, spring_chain_fixed_fixed_parameter_defaults,
       spring_chain_fixed_fixed_input_names, input_units, spring_chain_fixed_fixed_output_names, output_units,
       &spring_chain_fixed_fixed_operating_point, &spring_chain_fixed_fixed_linear, &spring_chain_fixed_fixed_residual, &spring_chain_fixed_fixed_mass_matrix,
-      0, false, "0.1.0", nullptr, &spring_chain_fixed_fixed_outputs};
+      0, false, "0.1.0", nullptr, &spring_chain_fixed_fixed_outputs,
+      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
+      nullptr, nullptr, nullptr,
+      0, 0, nullptr, nullptr,
+      nullptr, nullptr, nullptr, nullptr,
+      nullptr, nullptr,
+      spring_chain_fixed_fixed_n_sensitivity_parameters, spring_chain_fixed_fixed_sensitivity_parameter_names, &spring_chain_fixed_fixed_sensitivity, &spring_chain_fixed_fixed_operating_point_sensitivity};
   return k;
 }
 

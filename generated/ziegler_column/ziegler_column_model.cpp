@@ -26,7 +26,11 @@ const mbsgen::ModelKernels& kernels() {
       &ziegler_column_operating_point, &ziegler_column_linear, &ziegler_column_residual, &ziegler_column_mass_matrix,
       0, false, "0.1.0", nullptr, &ziegler_column_outputs,
       0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      &ziegler_column_dynamics, &ziegler_column_dynamics_jacobian, nullptr};
+      &ziegler_column_dynamics, &ziegler_column_dynamics_jacobian, nullptr,
+      0, 0, nullptr, nullptr,
+      nullptr, nullptr, nullptr, nullptr,
+      nullptr, nullptr,
+      ziegler_column_n_sensitivity_parameters, ziegler_column_sensitivity_parameter_names, &ziegler_column_sensitivity, nullptr};
   return k;
 }
 

@@ -7,6 +7,7 @@
 #include "mbsgen/generator/cse.hpp"
 #include "mbsgen/generator/escape.hpp"
 #include "mbsgen/generator/output_files.hpp"
+#include "mbsgen/generator/sensitivity.hpp"
 
 #include "child_task.hpp"
 #include "emit_chunks.hpp"
@@ -230,6 +231,9 @@ struct Buffer {
   std::vector<ex> values;  // name[i] = values[i]
   std::string doc;
   std::vector<char> zero_at_op = {};  // name[i] is exactly 0 at the operating point
+  /// Set to zero as a whole first (memset), with statements for the nonzero entries only: for
+  /// the mostly zero derivatives of the sensitivity kernel (the middle ear's: 204,315 of them).
+  bool zero_fill = false;
 };
 // A kernel's test whether it is called at the model's operating point: arguments[i] == values[i]
 // (structural_zeros.hpp); the entries marked zero_at_op are then set to exact zeros.
@@ -267,6 +271,15 @@ std::vector<ex> column_major(const ExMatrix& A, std::size_t rows, std::size_t co
 }
 
 std::string json_string(const std::string& s) { return json_string_literal(s); }
+
+// The parameters of the sensitivity kernel: the scene's, or all, in the model's order.
+std::vector<std::string> sensitivity_parameter_names(const Model& model) {
+  std::vector<std::string> names = model.selection().sensitivity_parameters;
+  if (names.empty())
+    for (const auto& q : model.parameters()) names.push_back(q.name);
+  return names;
+}
+
 
 struct EmittedKernel {
   std::string code;
@@ -328,7 +341,8 @@ std::vector<Statement> kernel_statements(const Kernel& k, Program& prog, bool cs
   if (k.computed_by.empty())  // otherwise the outputs come from computed_by
     for (const auto& b : k.outputs)
       for (std::size_t i = 0; i < b.values.size(); ++i)
-        statements.push_back({b.name + "[" + std::to_string(i) + "]", b.values[i], false, GiNaC::ex()});
+        if (!(b.zero_fill && b.values[i].is_zero()))
+          statements.push_back({b.name + "[" + std::to_string(i) + "]", b.values[i], false, GiNaC::ex()});
   for (std::size_t i = 0; i < k.at_op.values.size(); ++i)
     statements.push_back({"const double op" + std::to_string(i), k.at_op.values[i], false, GiNaC::ex()});
   if (cse) statements = eliminate_common_subexpressions(statements, prog.order());
@@ -452,6 +466,9 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
   code << "// " << k.doc << "\n// operations: " << operations << "\n";
   code << ((k.wrapped && !k.full_public) || k.internal ? "static " : "extern \"C\" ") << sig << " {\n";
   for (const auto& a : k.inputs) code << "  (void)" << a.name << ";\n";
+  for (const auto& b : k.outputs)
+    if (b.zero_fill && !b.values.empty())
+      code << "  std::memset(" << b.name << ", 0, sizeof(double) * " << b.values.size() << ");\n";
   code << body << zeros_at_operating_point(k);
   code << "  int status = 0;\n";
   if (!k.computed_by.empty()) code << "  if (computed_status > 1) return computed_status;\n";
@@ -822,6 +839,10 @@ std::string header_text(const Model& model, const Equations& eq, const LinearEqu
   h << "// Per input \"force\" or \"motion\" (a motion input prescribes a support's motion).\n";
   h << "extern const char* const " << out.id << "_input_kinds[];\n";
   h << "extern const char* const " << out.id << "_output_names[];\n";
+  if (std::any_of(out.kernels.begin(), out.kernels.end(), [](const KernelInfo& k) { return k.name == "sensitivity"; }))
+    h << "// Parameter sensitivities: the parameters of the sensitivity kernel, in its order.\nenum { " << out.id
+      << "_n_sensitivity_parameters = " << sensitivity_parameter_names(model).size() << " };\nextern const char* const "
+      << out.id << "_sensitivity_parameter_names[];\n";
   if (loops)
     h << "// Closed loops: the kernels take the independent coordinates (coordinate_names); "
          "assemble\n// and the constraint kernels all " << n << " tree coordinates.\nenum { " << out.id
@@ -1053,6 +1074,56 @@ Kernel bodies_kernel(const Equations& eq, std::size_t nb, const std::vector<ex>&
            {"m", mass, ""}, {"Ic", Ic, ""}}};
 }
 
+// sensitivity (sensitivity.hpp): the derivatives of the linear matrices by the scene's parameters,
+// and, when the operating point moves with them, operating_point_sensitivity.
+void sensitivity_kernels(const Model& model, Equations& eq, const LinearEquations& lin, const std::vector<ex>& y,
+                         const std::vector<ex>& yd, const std::vector<ex>& p, std::vector<Kernel>& kernels) {
+  const SceneSelection& scene = model.selection();
+  if (!scene.emits("sensitivity")) return;
+  if (scene.full && (eq.loops.active || eq.nonholonomic.active || lin.descriptor)) return;  // not available
+  std::vector<std::size_t> chosen;
+  for (const auto& name : scene.sensitivity_parameters)
+    for (std::size_t j = 0; j < model.parameters().size(); ++j)
+      if (model.parameters()[j].name == name) chosen.push_back(j);
+  const LinearSensitivity s = linear_sensitivity(eq, lin, chosen);
+  const std::vector<ex> none;
+  std::vector<ex> dy0(s.dy0.begin(), s.dy0.end()), dyd0;
+  if (!lin.at_rest) dyd0.assign(s.dyd0.begin(), s.dyd0.end());
+  Kernel k{"sensitivity",
+           "derivatives of the linear matrices by the parameters sensitivity_parameters (s of them) at (y0, yd0): "
+           "for each matrix, s blocks of its size one after the other, column-major; dy0, dyd0 (f×s): the "
+           "operating point's derivatives (operating_point_sensitivity; read only when the point moves)",
+           {{"y0", y}, {"yd0", lin.at_rest ? none : yd}, {"p", p}, {"dy0", dy0}, {"dyd0", dyd0}},
+           {}};
+  static const char* const names[] = {"M", "Q", "K", "B", "Cy", "Cv", "Ca", "D", "B1", "B2", "D1"};
+  std::vector<ZeroPattern> stacked;  // each matrix's zeros, repeated per parameter
+  for (const char* name : names) {
+    auto it = std::find_if(s.matrices.begin(), s.matrices.end(), [&](const MatrixDerivative& d) { return d.name == name; });
+    k.outputs.push_back({std::string("d") + name, it == s.matrices.end() ? none : it->values, ""});
+    k.outputs.back().zero_fill = true;
+    ZeroPattern z;
+    if (it != s.matrices.end() && it->zeros && !it->zeros->empty()) {
+      z.assign(it->rows, {});
+      for (std::size_t i = 0; i < it->rows; ++i)
+        for (std::size_t j = 0; j < s.parameters.size(); ++j)
+          z[i].insert(z[i].end(), (*it->zeros)[i].begin(), (*it->zeros)[i].end());
+    }
+    stacked.push_back(std::move(z));
+  }
+  std::vector<const ZeroPattern*> patterns;
+  for (const auto& z : stacked) patterns.push_back(&z);
+  mark_zeros_at_operating_point(k, patterns, eq, lin);
+  kernels.push_back(std::move(k));
+  if (!s.moving_point) return;
+  kernels.push_back({"operating_point_sensitivity",
+                     lin.equilibrium ? "the static equilibrium's sensitivity: dr = ∂r/∂p + Q dyd0 (f×s; then K dy0 = −dr) "
+                                       "and dyd0 = the steady rates' derivatives (f×s), column-major"
+                                     : "the given operating point's derivatives dy0, dyd0 by the sensitivity parameters "
+                                       "(f×s each, column-major)",
+                     {{"y0", y}, {"yd0", lin.at_rest ? none : yd}, {"p", p}},
+                     {{lin.equilibrium ? "dr" : "dy0", s.op_first, ""}, {"dyd0", s.op_rates, ""}}});
+}
+
 // The kernels of docs/generator.md, in emission order. With closed loops the coordinates y are
 // the tree's (n), the rates yd the independent ones, and the matrices those of the independent
 // coordinates (f); such kernels are wrapped (Kernel::wrapped).
@@ -1121,6 +1192,7 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
                         {"D1", column_major(lin.D1, r, m), ""}}});
     mark_zeros_at_operating_point(kernels.back(), {&lin.zeros.B1, &lin.zeros.B2, &lin.zeros.D1}, eq, lin);
   }
+  sensitivity_kernels(model, eq, lin, y, yd, p, kernels);
   kernels.push_back(bodies_kernel(eq, nb, y, p, f));
 
   if (loops)
@@ -1211,6 +1283,7 @@ std::string emitted_id(const Model& model, const EmitOptions& options) {
 std::string scene_kernel(const std::string& name) {
   if (name == "outputs_general") return "outputs";
   if (name == "dynamics" || name == "dynamics_jacobian") return "dynamics";
+  if (name == "operating_point_sensitivity") return "sensitivity";
   if (name == "output_terms" || name == "excitation" || name == "descriptor" || name == "reduced" || name == "reduced_parts") return "linear";
   return name;
 }
@@ -1513,6 +1586,8 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   std::vector<std::string> kinds;
   for (const auto& i : model.inputs()) kinds.push_back(i.motion ? "motion" : "force");
   c << names_array("input_kinds", kinds);
+  if (std::any_of(out.kernels.begin(), out.kernels.end(), [](const KernelInfo& k) { return k.name == "sensitivity"; }))
+    c << names_array("sensitivity_parameter_names", sensitivity_parameter_names(model));
   if (loops) c << names_array("tree_coordinate_names", tree);
   if (lin.descriptor) {
     std::vector<std::string> sn;

@@ -156,7 +156,8 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
       << lin.reduced.named.size() << ", " << id << "_reduced_part_names, " << kernel("reduced_parts");
   // Time integration (EmitOptions::dynamics), the outputs at any state, and closed loops.
   const bool loops = has_kernel(code, "assemble"), motion = model.has_motion_inputs();
-  if (has_kernel(code, "dynamics") || has_kernel(code, "outputs_general") || loops || motion) {
+  const bool sensitivity = has_kernel(code, "sensitivity");
+  if (has_kernel(code, "dynamics") || has_kernel(code, "outputs_general") || loops || motion || sensitivity) {
     if (!lin.descriptor) c << ",\n      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr";
     c << ",\n      " << kernel("dynamics") << ", " << kernel("dynamics_jacobian") << ", " << kernel("outputs_general");
   }
@@ -164,10 +165,15 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
     c << ",\n      " << id << "_n_tree_coordinates, " << id << "_n_constraints, " << kernel("assemble") << ", "
       << kernel("constraints") << ",\n      " << kernel("assemble_from") << ", " << kernel("dynamics_full") << ", "
       << kernel("outputs_full") << ", " << kernel("outputs_general_full");
-  else if (motion)
+  else if (motion || sensitivity)
     c << ",\n      0, 0, nullptr, nullptr,\n      nullptr, nullptr, nullptr, nullptr";
   // Prescribed motion: which inputs prescribe motion, and B1, B2, D1.
   if (motion) c << ",\n      " << id << "_input_kinds, " << kernel("excitation");
+  else if (sensitivity) c << ",\n      nullptr, nullptr";
+  // Parameter sensitivities: the parameters and the kernels.
+  if (sensitivity)
+    c << ",\n      " << id << "_n_sensitivity_parameters, " << id << "_sensitivity_parameter_names, "
+      << kernel("sensitivity") << ", " << kernel("operating_point_sensitivity");
   c << "};\n  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"

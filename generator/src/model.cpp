@@ -62,6 +62,7 @@ const char* to_string(Analysis analysis) {
     case Analysis::frf: return "frf";
     case Analysis::statics: return "static";
     case Analysis::simulate: return "simulate";
+    case Analysis::sensitivity: return "sensitivity";
   }
   return "";
 }

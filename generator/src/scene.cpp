@@ -12,7 +12,8 @@ namespace mbsgen {
 using GiNaC::ex;
 
 std::vector<std::string> SceneSelection::all_kernels() {
-  return {"mass_matrix", "residual", "linear", "linear_structured", "operating_point", "outputs", "bodies", "dynamics"};
+  return {"mass_matrix", "residual", "linear", "linear_structured", "operating_point", "outputs", "bodies", "dynamics",
+          "sensitivity"};
 }
 
 bool SceneSelection::emits(const std::string& kernel) const {
@@ -31,6 +32,7 @@ std::vector<std::string> kernels_of(Analysis analysis) {
     // The operating point's equilibrium, when the model asks for one, takes its Jacobian from
     // dynamics_jacobian (GeneratedModel::operating_point): no `linear`.
     case Analysis::simulate: return {"mass_matrix", "residual", "dynamics", "outputs"};
+    case Analysis::sensitivity: return {"linear", "sensitivity"};
   }
   return {};
 }
@@ -174,6 +176,15 @@ void check_scene(const Model& model, const Scene& scene) {
     for (const auto& o : model.outputs()) known.push_back(o.name);
     check_names(*scene.outputs, "output", known);
   }
+  if (scene.sensitivity) {
+    std::vector<std::string> known;
+    for (const auto& p : model.parameters()) known.push_back(p.name);
+    check_names(*scene.sensitivity, "parameter", known);
+    if (std::find(scene.analyses.begin(), scene.analyses.end(), Analysis::sensitivity) == scene.analyses.end())
+      throw ModelError(scene.sensitivity->empty() ? scene.where : scene.sensitivity->front().where,
+                       "scene '" + scene.name + "' lists sensitivity parameters but does not ask for the analysis "
+                       "'sensitivity' (add it to its analyses)");
+  }
 
   std::set<std::string> parameters;
   for (const auto& p : model.parameters()) parameters.insert(p.name);
@@ -192,7 +203,7 @@ void check_scene(const Model& model, const Scene& scene) {
     }
 
   if (scene.analyses.empty())
-    throw ModelError(scene.where, "scene '" + scene.name + "' asks for no analysis (modes, frf, static, simulate)");
+    throw ModelError(scene.where, "scene '" + scene.name + "' asks for no analysis (modes, frf, static, simulate, sensitivity)");
   for (std::size_t i = 0; i < scene.analyses.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (scene.analyses[i] == scene.analyses[j])
@@ -256,6 +267,10 @@ Model apply_scene(const Model& model, const std::string& name) {
   sel.full = false;
   sel.analyses = scene->analyses;
   sel.frequency_range = scene->frequency_range;
+  if (scene->sensitivity)  // in the model's order, as the kernel's outputs
+    for (const auto& p : model.parameters())
+      for (const auto& it : *scene->sensitivity)
+        if (it.name == p.name) sel.sensitivity_parameters.push_back(p.name);
   auto asks = [&](Analysis a) { return sel.asks(a); };
   sel.kernels.clear();
   for (const auto& k : SceneSelection::all_kernels()) {

@@ -1575,18 +1575,18 @@ std::vector<SceneItem> Reader::items(const Entry& e, const std::string& what) co
 void Reader::read_scene(const YAML::Node& n) {
   const Fields f = fields(n, "a scene",
                           {"name", "description", "analyses", "effects", "without", "inputs",
-                           "outputs", "operating_point", "frequency_range"});
+                           "outputs", "operating_point", "frequency_range", "sensitivity"});
   Scene s;
   s.name = name(require(f, "name", n, "a scene"), "a scene name");
   s.where = loc(n);
   const std::string what = "scene '" + s.name + "'";
   if (const Entry* d = find(f, "description")) s.description = scalar(value(*d), "a description");
   if (const Entry* a = find(f, "analyses")) {
-    static const std::vector<std::string> known = {"modes", "frf", "static", "simulate"};
+    static const std::vector<std::string> known = {"modes", "frf", "static", "simulate", "sensitivity"};
     s.analyses.clear();
     std::map<std::string, SourceLocation> seen;
     for (const auto& an : list(a, "the analyses of " + what)) {
-      const std::string k = scalar(an, "an analysis (modes, frf, static or simulate)");
+      const std::string k = scalar(an, "an analysis (modes, frf, static, simulate or sensitivity)");
       if (std::find(known.begin(), known.end(), k) == known.end()) {
         std::string hint = suggestion(k, known);
         if (hint.empty()) hint = " (one of: " + join(known) + ")";
@@ -1597,14 +1597,16 @@ void Reader::read_scene(const YAML::Node& n) {
       s.analyses.push_back(k == "modes"    ? Analysis::modes
                            : k == "frf"    ? Analysis::frf
                            : k == "static" ? Analysis::statics
-                                           : Analysis::simulate);
+                           : k == "simulate" ? Analysis::simulate
+                                             : Analysis::sensitivity);
     }
-    if (s.analyses.empty()) fail(a->key, what + " asks for no analysis (modes, frf, static, simulate)");
+    if (s.analyses.empty()) fail(a->key, what + " asks for no analysis (modes, frf, static, simulate, sensitivity)");
   }
   if (const Entry* e = find(f, "effects")) s.effects = items(*e, "the effects of " + what);
   if (const Entry* e = find(f, "without")) s.without = items(*e, "the effects " + what + " is without");
   if (const Entry* e = find(f, "inputs")) s.inputs = items(*e, "the inputs of " + what);
   if (const Entry* e = find(f, "outputs")) s.outputs = items(*e, "the outputs of " + what);
+  if (const Entry* e = find(f, "sensitivity")) s.sensitivity = items(*e, "the sensitivity parameters of " + what);
   if (const Entry* op = find(f, "operating_point"))
     s.operating_point = read_operating_point_values(value(*op), "the operating point of " + what);
   if (const Entry* fr = find(f, "frequency_range")) {

@@ -1,6 +1,10 @@
 #include "mbsgen/runtime/generated_model.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <limits>
 
 #include <cerrno>
 #include <cstdio>
@@ -269,6 +273,89 @@ LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
     lin = lin.with_input_rates(std::move(B1), std::move(B2), std::move(D1));
   }
   return lin;
+}
+
+}  // namespace mbsgen
+
+namespace mbsgen {
+
+std::vector<std::string> GeneratedModel::sensitivity_parameters() const {
+  return k_.sensitivity ? name_list(k_.sensitivity_parameter_names, k_.n_sensitivity_parameters)
+                        : std::vector<std::string>{};
+}
+
+namespace {
+
+// Column j of each derivative (s blocks of rows×cols one after the other), or 0×0 for an empty
+// buffer.
+Eigen::MatrixXd block(const std::vector<double>& buffer, Eigen::Index rows, Eigen::Index cols, Eigen::Index j) {
+  if (buffer.empty() || rows * cols == 0) return Eigen::MatrixXd();
+  return Eigen::Map<const Eigen::MatrixXd>(buffer.data() + j * rows * cols, rows, cols);
+}
+
+}  // namespace
+
+std::vector<MatrixSensitivity> GeneratedModel::linear_sensitivities(const OperatingPoint& op,
+                                                                    const std::vector<std::string>& names) const {
+  if (!k_.sensitivity)
+    throw Error("model '" + std::string(k_.model) + "', scene '" + k_.scene +
+                "': no sensitivity kernel (the full model has one unless it has closed loops or rolling constraints; "
+                "a scene needs the analysis 'sensitivity')");
+  const Eigen::Index f = size(), m = k_.n_inputs, r = k_.n_outputs, s = k_.n_sensitivity_parameters;
+  if (op.y0.size() != f || op.yd0.size() != f)
+    throw DimensionError("GeneratedModel::linear_sensitivities: operating point of size " + std::to_string(op.y0.size()) +
+                         "/" + std::to_string(op.yd0.size()) + " for a model with " + std::to_string(f) + " coordinates");
+  const std::vector<std::string> known = sensitivity_parameters();
+  std::vector<Eigen::Index> chosen;
+  for (const auto& n : names) {
+    const auto it = std::find(known.begin(), known.end(), n);
+    if (it == known.end()) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      throw NameError("no sensitivity to '" + n + "' in model '" + std::string(k_.model) + "' (parameters: " + list + ")");
+    }
+    chosen.push_back(it - known.begin());
+  }
+  if (names.empty())
+    for (Eigen::Index j = 0; j < s; ++j) chosen.push_back(j);
+  // The operating point's derivatives.
+  Eigen::MatrixXd dy0 = Eigen::MatrixXd::Zero(f, s), dyd0 = Eigen::MatrixXd::Zero(f, s);
+  if (k_.operating_point_sensitivity && f > 0 && s > 0) {
+    check_status(k_.operating_point_sensitivity(op.y0.data(), op.yd0.data(), p_.data(), dy0.data(), dyd0.data()),
+                 "operating_point_sensitivity", k_.model);
+    if (k_.equilibrium) {  // dy0 holds dr: K dy0 = −dr
+      const Eigen::PartialPivLU<Eigen::MatrixXd> lu(linear_model(op).K());
+      if (!(lu.rcond() > std::numeric_limits<double>::epsilon()))
+        throw SingularSystemError("GeneratedModel::linear_sensitivities: the stiffness matrix K of model '" +
+                                  std::string(k_.model) + "' is singular at its equilibrium (rcond " +
+                                  std::to_string(lu.rcond()) + "): the equilibrium does not move smoothly with the parameters");
+      dy0 = -lu.solve(dy0);
+    }
+  }
+  auto sized = [&](Eigen::Index rows, Eigen::Index cols) { return std::vector<double>(static_cast<std::size_t>(rows * cols * s)); };
+  std::vector<double> dM = sized(f, f), dQ = sized(f, f), dK = sized(f, f), dB = sized(f, m), dCy = sized(r, f),
+                      dCv = sized(r, f), dCa = sized(r, f), dD = sized(r, m), dB1 = sized(f, m), dB2 = sized(f, m),
+                      dD1 = sized(r, m);
+  double dummy[1] = {0};
+  auto ptr = [&dummy](std::vector<double>& v) { return v.empty() ? dummy : v.data(); };
+  check_status(k_.sensitivity(op.y0.data(), op.yd0.data(), p_.data(), dy0.size() ? dy0.data() : dummy,
+                              dyd0.size() ? dyd0.data() : dummy, ptr(dM), ptr(dQ), ptr(dK), ptr(dB), ptr(dCy), ptr(dCv),
+                              ptr(dCa), ptr(dD), ptr(dB1), ptr(dB2), ptr(dD1)),
+               "sensitivity", k_.model);
+  const std::vector<std::string> all = name_list(k_.parameter_names, k_.n_parameters);
+  std::vector<MatrixSensitivity> out;
+  for (Eigen::Index j : chosen) {
+    MatrixSensitivity d;
+    d.parameter = known[static_cast<std::size_t>(j)];
+    d.value = p_[static_cast<std::size_t>(std::find(all.begin(), all.end(), d.parameter) - all.begin())];
+    d.M = block(dM, f, f, j), d.Q = block(dQ, f, f, j), d.K = block(dK, f, f, j), d.B = block(dB, f, m, j);
+    d.C_y = block(dCy, r, f, j), d.C_v = block(dCv, r, f, j);
+    if (k_.output_terms) d.C_a = block(dCa, r, f, j), d.D = block(dD, r, m, j);
+    if (k_.excitation) d.B1 = block(dB1, f, m, j), d.B2 = block(dB2, f, m, j), d.D1 = block(dD1, r, m, j);
+    d.dy0 = dy0.col(j), d.dyd0 = dyd0.col(j);
+    out.push_back(std::move(d));
+  }
+  return out;
 }
 
 }  // namespace mbsgen

@@ -18,6 +18,7 @@
 #include "bode_plot.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
+#include "sensitivity_cli.hpp"
 #include "simulate_cli.hpp"
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/matrix_market.hpp"
@@ -45,6 +46,8 @@ struct Options {
   long points = 200;
   double from = 0, to = 0;
   std::string parameter;  ///< sweep
+  std::vector<std::string> sensitivity;  ///< modes, frf: --sensitivity [PARAMETER…] (empty: all)
+  bool sensitivity_given = false;
 };
 
 GeneratedModel configured(const ModelKernels& k, const Options& o) {
@@ -95,6 +98,10 @@ int run_descriptor_modes(const GeneratedModel& model, const Options& o, std::ost
 int run_modes(const ModelKernels& k, const Options& o, std::ostream& out) {
   GeneratedModel model = configured(k, o);
   if (model.is_descriptor()) return run_descriptor_modes(model, o, out);
+  if (o.sensitivity_given) {
+    write_modes_sensitivity(out, model, o.sensitivity, o.format, o.all);
+    return 0;
+  }
   const LinearModel lin = model.linear_model();
   QuadraticEigenOptions opt;
   opt.one_per_conjugate_pair = !o.all;
@@ -140,6 +147,14 @@ int run_frf(const ModelKernels& k, const Options& o, std::ostream& out, std::ost
   const Eigen::Index input = model.input_index(o.input), output = model.output_index(o.output);
   if (!o.plot.empty()) refuse_special_file(o.plot, "--plot");  // before the sweep, not after
   const Eigen::VectorXd hz = sweep_hz(o.from, o.to, o.points, o.spacing == "log");
+  if (o.sensitivity_given) {
+    if (model.is_descriptor())
+      throw Error("frf --sensitivity: model '" + std::string(k.model) + "' has rolling constraints; sensitivities "
+                  "are not available for it");
+    if (!o.plot.empty()) throw Error("frf: --plot draws the response; with --sensitivity write csv or json instead");
+    write_frf_sensitivity(out, model, input, output, hz, o.sensitivity, o.format);
+    return 0;
+  }
   FrfResult r{hz, Eigen::VectorXcd(o.points), Eigen::VectorXd(o.points), {}, FrfMethod::automatic};
   if (model.is_descriptor()) {  // (iΩE − A)⁻¹ B by complex LU per frequency
     const DescriptorFrf d = descriptor_frequency_response(model.descriptor_model(), hz * kTwoPi, input, {output},
@@ -400,6 +415,10 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   modes->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json", "csv"}));
   modes->add_flag("--shapes", o.shapes, "print the mode shapes");
   modes->add_flag("--all", o.all, "both members of each complex-conjugate pair");
+  modes->add_option("--sensitivity", o.sensitivity,
+                    "eigenvalue sensitivities dλ/dp, (p/f) df/dp, dζ/dp to these parameters (none named: all)")
+      ->expected(0, CLI::detail::expected_max_vector_size)
+      ->delimiter(',');
   CLI::App* frf = app.add_subcommand("frf", "frequency response of one output to one input");
   add_set(frf);
   frf->add_option("--input", o.input, "input name")->required();
@@ -414,6 +433,10 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
       ->check(CLI::IsMember({"flag", "error"}));
   frf->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json", "csv"}));
   frf->add_option("--plot", o.plot, "write a Bode plot (FILE.svg or FILE.png)");
+  frf->add_option("--sensitivity", o.sensitivity,
+                  "the response's sensitivities d ln|z|/d ln p, d arg z/d ln p, dz/dp to these parameters (none: all)")
+      ->expected(0, CLI::detail::expected_max_vector_size)
+      ->delimiter(',');
   CLI::App* stat = app.add_subcommand("static", "the operating point: equilibrium, residual, iterations");
   add_set(stat);
   stat->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json"}));
@@ -448,6 +471,9 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     return 2;
   }
   if (matrices->parsed() && o.format == "table") o.format = "json";
+  o.sensitivity_given = (modes->parsed() && modes->get_option("--sensitivity")->count() > 0) ||
+                        (frf->parsed() && frf->get_option("--sensitivity")->count() > 0);
+  o.sensitivity.erase(std::remove(o.sensitivity.begin(), o.sensitivity.end(), std::string()), o.sensitivity.end());
   if (sweep->parsed() && sweep->get_option("--points")->count() == 0) o.points = 101;
   if (frf->parsed()) {
     const std::string problem = sweep_from_scene(k, *frf, o);

@@ -178,16 +178,15 @@ double backward_error(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q, const 
   return num / den;
 }
 
-std::complex<double> refine_eigenvalue(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
-                                       const Eigen::MatrixXd& K, std::complex<double> lambda0,
-                                       const Eigen::VectorXcd& x0) {
-  const Index n = M.rows();
+namespace {
+// Newton's method on (P(λ)x = 0, x_k = 1) for high-precision coefficients.
+cl_N refine(const Matrix& hM, const Matrix& hQ, const Matrix& hK, std::complex<double> lambda0, const Eigen::VectorXcd& x0) {
+  const Index n = hM.rows;
   Index kmax = 0;
   x0.cwiseAbs().maxCoeff(&kmax);
   Vector x = from(Eigen::VectorXcd(x0 / x0[kmax]));
   x[static_cast<std::size_t>(kmax)] = 1;
   cl_N lam = cplx(lambda0);
-  const Matrix hM = from(M), hQ = from(Q), hK = from(K);
   for (int it = 0; it < 40; ++it) {
     Matrix J(n + 1, n + 1);
     Vector rhs(static_cast<std::size_t>(n + 1), cl_N(0));
@@ -209,9 +208,59 @@ std::complex<double> refine_eigenvalue(const Eigen::MatrixXd& M, const Eigen::Ma
       x[static_cast<std::size_t>(i)] = x[static_cast<std::size_t>(i)] + d[static_cast<std::size_t>(i)];
     lam = lam + d[static_cast<std::size_t>(n)];
     if (cln::abs(d[static_cast<std::size_t>(n)]) <= cln::abs(lam) * cln::cl_float(1, precision()) / cln::expt(cln::cl_I(10), 50))
-      return to_double(lam);
+      return lam;
   }
   throw std::runtime_error("hp::refine_eigenvalue: Newton did not converge");
+}
+
+// A + t dA in high precision.
+Matrix shifted(const Eigen::MatrixXd& A, const Eigen::MatrixXd& dA, const cl_R& t) {
+  Matrix H = from(A);
+  for (Index j = 0; j < A.cols(); ++j)
+    for (Index i = 0; i < A.rows(); ++i)
+      if (dA.size() && dA(i, j) != 0.0) H(i, j) = H(i, j) + t * real(dA(i, j));
+  return H;
+}
+
+cl_R tiny() { return cln::cl_float(1, precision()) / cln::expt(cln::cl_I(10), 30); }
+}  // namespace
+
+std::complex<double> refine_eigenvalue(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
+                                       const Eigen::MatrixXd& K, std::complex<double> lambda0,
+                                       const Eigen::VectorXcd& x0) {
+  return to_double(refine(from(M), from(Q), from(K), lambda0, x0));
+}
+
+std::complex<double> eigenvalue_derivative(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& K,
+                                           const Eigen::MatrixXd& dM, const Eigen::MatrixXd& dQ,
+                                           const Eigen::MatrixXd& dK, std::complex<double> lambda0,
+                                           const Eigen::VectorXcd& x0) {
+  const cl_R h = tiny();
+  const cl_N plus = refine(shifted(M, dM, h), shifted(Q, dQ, h), shifted(K, dK, h), lambda0, x0);
+  const cl_N minus = refine(shifted(M, dM, -h), shifted(Q, dQ, -h), shifted(K, dK, -h), lambda0, x0);
+  return to_double((plus - minus) / (2 * h));
+}
+
+std::complex<double> frf_derivative(const std::array<Eigen::MatrixXd, 5>& X, const Eigen::VectorXd& b,
+                                    const std::array<Eigen::MatrixXd, 5>& dX, const Eigen::VectorXd& db,
+                                    double omega, Index row) {
+  const cl_R om = real(omega), h = tiny();
+  const cl_N iom = cln::complex(0, om);
+  auto z = [&](const cl_R& t) {
+    const Matrix M = shifted(X[0], dX[0], t), Q = shifted(X[1], dX[1], t), K = shifted(X[2], dX[2], t);
+    const Matrix Cy = shifted(X[3], dX[3], t), Cv = shifted(X[4], dX[4], t);
+    const Index n = M.rows;
+    Matrix A(n, n);
+    for (Index j = 0; j < n; ++j)
+      for (Index i = 0; i < n; ++i) A(i, j) = K(i, j) - om * om * M(i, j) + iom * Q(i, j);
+    Vector rhs = from(b);
+    for (Index i = 0; i < n; ++i) rhs[static_cast<std::size_t>(i)] = rhs[static_cast<std::size_t>(i)] + t * real(db[i]);
+    const Vector y = solve(A, rhs);
+    cl_N s = 0;
+    for (Index j = 0; j < n; ++j) s = s + (Cy(row, j) + iom * Cv(row, j)) * y[static_cast<std::size_t>(j)];
+    return s;
+  };
+  return to_double((z(h) - z(-h)) / (2 * h));
 }
 
 }  // namespace hp

@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <cln/cln.h>
+#include <array>
 #include <complex>
 #include <vector>
 
@@ -59,5 +60,21 @@ double backward_error(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q, const 
 std::complex<double> refine_eigenvalue(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
                                        const Eigen::MatrixXd& K, std::complex<double> lambda0,
                                        const Eigen::VectorXcd& x0);
+
+/// dλ/dt at t = 0 of the eigenvalue near lambda0 of (M + t dM, Q + t dQ, K + t dK), by central
+/// differences in high precision: Newton (as refine_eigenvalue) at t = ±1e-30, so that the
+/// difference's truncation error, O(1e-60), and its rounding, O(1e-80/1e-30), are far below a
+/// double's resolution. Throws std::runtime_error when Newton does not converge.
+std::complex<double> eigenvalue_derivative(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q, const Eigen::MatrixXd& K,
+                                           const Eigen::MatrixXd& dM, const Eigen::MatrixXd& dQ,
+                                           const Eigen::MatrixXd& dK, std::complex<double> lambda0,
+                                           const Eigen::VectorXcd& x0);
+
+/// dẑ/dt at t = 0 of ẑ = (C_y + iΩC_v)(K − Ω²M + iΩQ)⁻¹ b with every matrix X replaced by
+/// X + t dX (b by b + t db), for output row `row`, by central differences in high precision at
+/// t = ±1e-30 (dense solves).
+std::complex<double> frf_derivative(const std::array<Eigen::MatrixXd, 5>& MQKCyCv, const Eigen::VectorXd& b,
+                                    const std::array<Eigen::MatrixXd, 5>& derivatives, const Eigen::VectorXd& db,
+                                    double omega, Index row);
 
 }  // namespace hp

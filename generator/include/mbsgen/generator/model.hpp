@@ -270,10 +270,11 @@ enum class Analysis {
   modes,  ///< eigenvalues of λ²M + λQ + K: kernels linear and linear_structured
   frf,    ///< frequency responses: kernel linear (M, Q, K, B, C)
   statics, ///< static equilibrium by Newton's method: kernels residual and linear (K)
-  simulate ///< time integration: mass_matrix, residual, dynamics (with its Jacobian), outputs
+  simulate, ///< time integration: mass_matrix, residual, dynamics (with its Jacobian), outputs
+  sensitivity ///< parameter sensitivities of the linear model: linear and sensitivity (issue 20)
 };
 
-/// "modes", "frf", "static", "simulate".
+/// "modes", "frf", "static", "simulate", "sensitivity".
 const char* to_string(Analysis analysis);
 
 /// A name written in a scene, with its place in the model file.
@@ -319,6 +320,9 @@ struct Scene {
   std::vector<Analysis> analyses = {Analysis::modes, Analysis::frf, Analysis::statics};
   OperatingPointOverride operating_point;
   std::optional<FrequencyRange> frequency_range;
+  /// The parameters whose sensitivities the scene asks for (analysis `sensitivity`): all when
+  /// absent.
+  std::optional<std::vector<SceneItem>> sensitivity;
   SourceLocation where;
 };
 
@@ -346,6 +350,8 @@ struct SceneSelection {
   /// model: everything is active).
   std::vector<EffectState> effects;
   std::optional<FrequencyRange> frequency_range;
+  /// The parameters of the `sensitivity` kernel, by name, in the model's order (empty: all).
+  std::vector<std::string> sensitivity_parameters;
 
   /// mass_matrix, residual, linear, linear_structured, operating_point, outputs, bodies, dynamics
   /// (`dynamics` and `dynamics_jacobian`: in the full scene only with EmitOptions::dynamics).

@@ -14,6 +14,7 @@
 #include "mbsgen/runtime/error.hpp"
 #include "mbsgen/runtime/descriptor_model.hpp"
 #include "mbsgen/runtime/linear_model.hpp"
+#include "mbsgen/runtime/sensitivity.hpp"
 
 namespace mbsgen {
 
@@ -115,6 +116,20 @@ struct ModelKernels {
   const char* const* input_kinds = nullptr;
   int (*excitation)(const double* y0, const double* yd0, const double* p, double* B1, double* B2,
                     double* D1) = nullptr;
+  /// Parameter sensitivities (issue 20; null: not emitted): the s parameters, and the
+  /// derivatives of the linear matrices by them at (y0, yd0), each matrix's s blocks one after
+  /// the other, column-major (empty for matrices the model does not have: Ca, D without
+  /// output_terms, B1, B2, D1 without excitation). dy0, dyd0 (f×s) are the operating point's
+  /// derivatives, read only when operating_point_sensitivity is not null; that kernel gives
+  /// them: for a given point dy0 and dyd0, for an equilibrium dr = ∂r/∂p + Q dyd0 (then
+  /// K dy0 = −dr) and dyd0. Trailing.
+  int n_sensitivity_parameters = 0;
+  const char* const* sensitivity_parameter_names = nullptr;
+  int (*sensitivity)(const double* y0, const double* yd0, const double* p, const double* dy0, const double* dyd0,
+                     double* dM, double* dQ, double* dK, double* dB, double* dCy, double* dCv, double* dCa,
+                     double* dD, double* dB1, double* dB2, double* dD1) = nullptr;
+  int (*operating_point_sensitivity)(const double* y0, const double* yd0, const double* p, double* dy0,
+                                     double* dyd0) = nullptr;
 };
 
 /// True when input j of the kernels prescribes motion (input_kinds, prescribed motion).
@@ -177,6 +192,18 @@ class GeneratedModel {
   /// set this way (a negative mass or inertia) would give numbers that only look like results.
   LinearModel linear_model(const OperatingPoint& op) const;
   LinearModel linear_model() const { return linear_model(operating_point()); }
+  /// True when the kernels have `sensitivity` (issue 20: the full model, or a scene that asks
+  /// for the analysis `sensitivity`; not for closed loops or rolling constraints).
+  bool has_sensitivities() const { return k_.sensitivity != nullptr; }
+  /// The parameters of the sensitivity kernel, in its order (empty without it).
+  std::vector<std::string> sensitivity_parameters() const;
+  /// The derivatives of the linear matrices at op by the named parameters (all of the kernel's
+  /// when empty), in the order asked: the total derivatives, with the operating point's own
+  /// (an equilibrium's by K dy0 = −(∂r/∂p + Q dẏ0)). Throws Error when the kernels have no
+  /// sensitivity kernel (saying how to get one), NameError for a parameter the kernel does not
+  /// have (listing those it has), SingularSystemError when an equilibrium's K is singular.
+  std::vector<MatrixSensitivity> linear_sensitivities(const OperatingPoint& op,
+                                                      const std::vector<std::string>& names = {}) const;
   /// True for a model with nonholonomic constraints, whose linear model is first order:
   /// descriptor_model() (linear_model() throws).
   bool is_descriptor() const { return k_.descriptor != nullptr; }
