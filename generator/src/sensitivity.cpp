@@ -52,14 +52,24 @@ void screen_zeros(Equations& eq, const LinearEquations& lin, LinearSensitivity& 
   for (std::size_t a = 0; a < mats.size(); ++a) {
     MatrixDerivative& d = s.matrices[a];
     const ExMatrix& A = *mats[a].first;
-    std::vector<ex> entries;  // A's entries, then the parameters, then the nonzero derivatives
-    for (const auto& row : A)
-      for (const ex& x : row) entries.push_back(x);
+    // Only the entries of A that are nonzero at the operating point: one that vanishes there
+    // (structural_zeros.hpp) is rounding noise at the sample points, a scale that would make the
+    // screen's verdicts depend on the order of the sums (GiNaC's, from run to run); its
+    // derivative is a conditional zero of the kernel already.
+    auto nonzero = [&](std::size_t i, std::size_t c) {
+      return d.zeros->empty() || (*d.zeros)[i][c] == EntryZero::nonzero;
+    };
+    std::vector<ex> entries;  // those entries of A, then the parameters, then their nonzero derivatives
+    for (std::size_t i = 0; i < d.rows; ++i)
+      for (std::size_t c = 0; c < d.cols; ++c)
+        if (nonzero(i, c)) entries.push_back(A[i][c]);
     const std::size_t n_a = entries.size();
     for (std::size_t j : s.parameters) entries.push_back(eq.p[j]);
     std::vector<std::size_t> at;
-    for (std::size_t k = 0; k < d.values.size(); ++k)
-      if (!d.values[k].is_zero()) at.push_back(k), entries.push_back(d.values[k]);
+    for (std::size_t k = 0; k < d.values.size(); ++k) {
+      const std::size_t within = k % (d.rows * d.cols);
+      if (!d.values[k].is_zero() && nonzero(within % d.rows, within / d.rows)) at.push_back(k), entries.push_back(d.values[k]);
+    }
     if (at.empty()) continue;
     std::vector<bool> small(at.size(), true);
     try {
@@ -175,8 +185,11 @@ LinearSensitivity linear_sensitivity(Equations& eq, const LinearEquations& lin, 
     d.values.assign(np * d.rows * d.cols, 0);
     for (std::size_t c = 0; c < d.cols; ++c)
       for (std::size_t i = 0; i < d.rows; ++i) {
-        const ex& x = (*A)[i][c];
-        if (x.is_zero()) continue;
+        if ((*A)[i][c].is_zero()) continue;
+        // Named first, as linearize() names the residual: the chain rule then runs through the
+        // program's intermediates in their canonical order, not GiNaC's operand order (which
+        // follows hashes that differ from run to run).
+        const ex x = prog.define((*A)[i][c]);
         for (std::size_t j = 0; j < np; ++j)
           if (prog.depends_on(x, eq.p[parameters[j]]))
             d.values[j * d.rows * d.cols + c * d.rows + i] = prog.diff(x, eq.p[parameters[j]]);

@@ -253,7 +253,47 @@ std::string time_script(const std::string& terminal, const Eigen::VectorXd& t, c
   return s.str();
 }
 
+// The band plot's script: data inline, as bode_script.
+std::string band_script(const std::string& terminal, const std::vector<double>& hz,
+                        const std::vector<std::vector<double>>& b, const BandPlot& plot) {
+  std::ostringstream s;
+  s << "set terminal " << terminal << "\n$band << EOD\n";
+  double lo = 0, hi = 0;
+  for (std::size_t k = 0; k < hz.size(); ++k) {
+    bool ok = hz[k] > 0;
+    for (const auto& row : b) ok = ok && std::isfinite(row[k]) && row[k] > 0;
+    if (!ok) continue;  // log axes
+    if (lo == 0) lo = hz[k];
+    hi = hz[k];
+    char line[256];
+    std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g %.17g %.17g\n", hz[k], b[0][k], b[1][k], b[2][k],
+                  b[3][k], b[4][k]);
+    s << line;
+  }
+  s << "EOD\n"
+    << "set title " << gnuplot_string(plot.title) << " noenhanced\n";
+  if (hi > lo) s << "set xrange [" << lo << ":" << hi << "]\n";
+  s << "set logscale xy\nset grid xtics ytics mxtics\nset format x '10^{%L}'\nset format y '10^{%L}'\n"
+    << "set xlabel 'frequency [Hz]'\nset ylabel " << gnuplot_string(plot.amplitude_label) << " noenhanced\n"
+    << "set key top left\n"
+    << "plot $band using 1:2:6 with filledcurves lc rgb '#c6d4ee' title '5-95 %', "
+    << "$band using 1:3:5 with filledcurves lc rgb '#8fa9dc' title '25-75 %', "
+    << "$band using 1:4 with lines lw 2 lc rgb '#1f4e9c' title 'median'\n";
+  return s.str();
+}
+
 }  // namespace
+
+void write_band_plot(const std::string& path, const std::vector<double>& hz,
+                     const std::vector<std::vector<double>>& bands, const BandPlot& plot) {
+  if (bands.size() != 5)
+    throw DimensionError("write_band_plot: " + std::to_string(bands.size()) + " percentile rows, 5 expected");
+  for (const auto& row : bands)
+    if (row.size() != hz.size())
+      throw DimensionError("write_band_plot: a band of " + std::to_string(row.size()) + " values for " +
+                           std::to_string(hz.size()) + " frequencies");
+  render(path, [&](const std::string& terminal) { return band_script(terminal, hz, bands, plot); });
+}
 
 void write_time_plot(const std::string& path, const Eigen::VectorXd& t, const Eigen::MatrixXd& values,
                      const TimePlot& plot) {

@@ -48,4 +48,15 @@ inline constexpr Eigen::Index kMaxTimePanels = 8;
 void write_time_plot(const std::string& path, const Eigen::VectorXd& t, const Eigen::MatrixXd& values,
                      const TimePlot& plot);
 
+struct BandPlot {
+  std::string title;
+  std::string amplitude_label;  // e.g. "|v_stapes / P| [(m/s)/Pa]"
+};
+
+/// Writes percentile bands of an amplitude over frequency (log–log): the 5–95 % band shaded, the
+/// 25–75 % band darker, the median as a line; bands rows p5, p25, p50, p75, p95 at hz. As
+/// write_bode_plot does. DimensionError for sizes that do not fit.
+void write_band_plot(const std::string& path, const std::vector<double>& hz,
+                     const std::vector<std::vector<double>>& bands, const BandPlot& plot);
+
 }  // namespace mbsgen::cli

@@ -20,6 +20,7 @@
 #include "cli_output.hpp"
 #include "sensitivity_cli.hpp"
 #include "simulate_cli.hpp"
+#include "study_cli.hpp"
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/matrix_market.hpp"
 #include "mbsgen/runtime/quadratic_eigen.hpp"
@@ -456,6 +457,8 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   matrices->add_option("--out", o.out_dir, "directory of the .mtx files (default: current)");
   SimulateOptions simulate_options;
   CLI::App* simulate = add_simulate(app, simulate_options);
+  StudyOptions study_options;
+  CLI::App* study = add_study(app, study_options);
   o.format = "table";
   try {
     app.parse(argc, argv);
@@ -489,6 +492,7 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     if (stat->parsed()) return run_static(k, o, out);
     if (sweep->parsed()) return run_sweep(k, o, out, err);
     if (simulate->parsed()) return run_simulate(k, simulate_options, out, err);
+    if (study->parsed()) return run_study(k, study_options, out, err);
     return run_matrices(k, o, out, err);
   } catch (const NameError& e) {
     err << program << ": " << e.what() << "\n";

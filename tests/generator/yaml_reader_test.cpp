@@ -87,7 +87,8 @@ INSTANTIATE_TEST_SUITE_P(
                     TextbookCase{"ziegler_column.yaml", 2, 2},
                     TextbookCase{"chain3_sympy.yaml", 3, 3},
                     TextbookCase{"base_excited_oscillator.yaml", 1, 2},
-                    TextbookCase{"shaken_pendulum.yaml", 1, 2}),
+                    TextbookCase{"shaken_pendulum.yaml", 1, 2},
+                    TextbookCase{"torqued_pendulum.yaml", 1, 1}),
     [](const testing::TestParamInfo<TextbookCase>& param_info) {
       std::string name = param_info.param.file;
       return name.substr(0, name.find('.'));
@@ -97,7 +98,7 @@ TEST(TextbookModels, EveryFileIsListed) {
   std::size_t n = 0;
   for (const auto& entry : fs::directory_iterator(kSourceDir + "/models/textbook"))
     if (entry.path().extension() == ".yaml") ++n;
-  EXPECT_EQ(n, 16u) << "a model file was added or removed: update the list of TextbookModel";
+  EXPECT_EQ(n, 17u) << "a model file was added or removed: update the list of TextbookModel";
 }
 
 TEST(DoublePendulum, ContentsAsWritten) {
