@@ -11,6 +11,9 @@
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "mbsgen/runtime/quadratic_eigen.hpp"
 
+// OpenBLAS's own threads, when the library is OpenBLAS (a weak reference: null with another BLAS).
+extern "C" void openblas_set_num_threads(int) __attribute__((weak));
+
 namespace mbsgen {
 
 namespace {
@@ -101,6 +104,11 @@ StudyResults evaluate(const GeneratedModel& model, const StudyDesign& design, co
   for (std::size_t i = 0; i < q.at_hz.size(); ++i)
     omega[static_cast<Eigen::Index>(q.sweep_hz.size() + i)] = kTwoPi * q.at_hz[i];
 
+  // One BLAS thread: the study's threads share out the evaluations, and OpenBLAS's results for a
+  // given matrix depend on how many threads it splits the work over (its blocking), so that a
+  // rank of an MPI job (one thread, as mpirun binds it) and a process on its own (all cores)
+  // would differ in the last bits.
+  if (openblas_set_num_threads) openblas_set_num_threads(1);
   StudyResults r;
   r.first = first, r.count = count;
   r.scalar_names = scalar_names(q);

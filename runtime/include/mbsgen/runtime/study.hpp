@@ -58,7 +58,8 @@ std::vector<std::string> scalar_names(const StudyQuantities& q);
 
 /// Evaluates design points first … first + count − 1 of `design` on `model` (its parameters not
 /// in the design keep their values), with `threads` threads (0: std::thread::hardware_concurrency).
-/// progress(done) is called now and then from the calling thread (may be empty). Throws NameError
+/// progress(done) is called now and then from the calling thread (may be empty). Sets OpenBLAS,
+/// when it is the BLAS, to one thread (its results depend on its thread count). Throws NameError
 /// for a design parameter, input or output the model does not have, Error for a descriptor model
 /// with modes or responses, DimensionError for a range beyond the design.
 StudyResults evaluate(const GeneratedModel& model, const StudyDesign& design, const StudyQuantities& quantities,
