@@ -112,11 +112,17 @@ for ext in png svg; do
   mv "$out/middle_ear_bone_conduction.$ext.tmp" "$out/middle_ear_bone_conduction.$ext"
 done
 
+# A parameter study of the ligaments and joints (docs/studies.md): 10,000 Latin-hypercube
+# samples, the 5-95 % band of |H| beside the reference, and Sobol' indices at 0.5, 1 and 4 kHz.
+echo
+scripts/middle_ear_study.sh "$solve" "$out/study"
+
 echo
 echo "Wrote, in $(pwd)/$out:"
 echo "  middle_ear_bode.png, middle_ear_bode.svg   Bode plot: model, stapes fixation x10/x100,"
 echo "                                             reference band and measured points"
 echo "  default.csv, fixation10.csv, fixation100.csv, isj.csv   H (re, im in (m/s)/Pa), solver CSV"
 echo "  middle_ear_bone_conduction.png, .svg        bone conduction beside air conduction"
+echo "  study/middle_ear_study.png, .svg            the band of a population of ligament parameters"
 echo "  bc_x.csv, bc_y.csv, bc_z.csv               V_stapes,rel per bone displacement ((m/s)/m)"
 echo "  modes.csv, modes_shapes.txt                 eigenvalues and mode shapes"
