@@ -290,6 +290,10 @@ Model apply_scene(const Model& model, const std::string& name) {
   if (asks(Analysis::simulate) && m.operating_point_.kind == OperatingPoint::Kind::equilibrium &&
       !model.constraints().empty() && !sel.emits("linear"))
     sel.kernels.insert(std::find(sel.kernels.begin(), sel.kernels.end(), "residual") + 1, "linear");
+  // Any analysis at an equilibrium finds it first, by Newton's method on `residual`: without it
+  // the runtime would linearize at the initial guess (a modes-only or sensitivity scene).
+  if (m.operating_point_.kind == OperatingPoint::Kind::equilibrium && sel.emits("linear") && !sel.emits("residual"))
+    sel.kernels.insert(std::find(sel.kernels.begin(), sel.kernels.end(), "linear"), "residual");
   for (const auto& [c, v] : op.position) m.operating_point_.position[c] = v;
   for (const auto& [c, v] : op.velocity) m.operating_point_.velocity[c] = v;
   if (op.where.line > 0) m.operating_point_.where = op.where;

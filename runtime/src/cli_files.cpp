@@ -92,13 +92,19 @@ void refuse_special_file(const fs::path& path, const std::string& what) {
   (void)exists_regular(path, what);
 }
 
-void write_all_or_nothing(const std::vector<OutputFile>& files, const std::string& marker,
-                          const std::string& what) {
-  for (const auto& f : files)
-    if (exists_regular(f.path, what) && head_of(f.path, 400, what).find(marker) == std::string::npos)
-      throw Error(what + ": refusing to overwrite " + f.path.string() +
+void refuse_foreign_files(const std::vector<fs::path>& paths, const std::string& marker, const std::string& what) {
+  for (const auto& p : paths)
+    if (exists_regular(p, what) && head_of(p, 400, what).find(marker) == std::string::npos)
+      throw Error(what + ": refusing to overwrite " + p.string() +
                   ": it exists and was not written by mbsgen (move it, or choose another directory); "
                   "nothing was written");
+}
+
+void write_all_or_nothing(const std::vector<OutputFile>& files, const std::string& marker,
+                          const std::string& what) {
+  std::vector<fs::path> paths;
+  for (const auto& f : files) paths.push_back(f.path);
+  refuse_foreign_files(paths, marker, what);
   std::vector<fs::path> temporaries;
   auto remove_from = [&temporaries](std::size_t first) {
     for (std::size_t i = first; i < temporaries.size(); ++i) ::unlink(temporaries[i].c_str());

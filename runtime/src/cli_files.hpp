@@ -18,6 +18,11 @@ struct OutputFile {
   std::string content;
 };
 
+/// Throws Error, as write_all_or_nothing would, when one of paths exists and is not a regular file
+/// whose first 400 bytes contain `marker`: for a command that checks its targets before long work.
+void refuse_foreign_files(const std::vector<std::filesystem::path>& paths, const std::string& marker,
+                          const std::string& what);
+
 /// Writes every file or none. Every target is checked first: it must be absent, or a regular file
 /// whose first 400 bytes contain `marker` (mbsgen wrote it); otherwise Error "refusing to
 /// overwrite …" and nothing is written. Then each content goes to a new temporary file beside its

@@ -305,6 +305,10 @@ std::vector<MatrixSensitivity> GeneratedModel::linear_sensitivities(const Operat
   if (op.y0.size() != f || op.yd0.size() != f)
     throw DimensionError("GeneratedModel::linear_sensitivities: operating point of size " + std::to_string(op.y0.size()) +
                          "/" + std::to_string(op.yd0.size()) + " for a model with " + std::to_string(f) + " coordinates");
+  if (k_.equilibrium && !op.equilibrium)
+    throw Error("GeneratedModel::linear_sensitivities: model '" + std::string(k_.model) +
+                "' is linearized at a static equilibrium, and this operating point is not one (found by "
+                "operating_point(): " + op.report + ")");
   const std::vector<std::string> known = sensitivity_parameters();
   std::vector<Eigen::Index> chosen;
   for (const auto& n : names) {

@@ -29,7 +29,8 @@ Eigen::MatrixXd part(const Eigen::MatrixXd& A, Eigen::Index rows, Eigen::Index c
 bool separated(const std::vector<Mode>& modes, std::size_t k) {
   const double u = std::numeric_limits<double>::epsilon();
   for (std::size_t j = 0; j < modes.size(); ++j) {
-    if (j == k || modes[j].kind != EigenvalueKind::finite) continue;
+    // A mode whose own bound is infinite (defective) is flagged itself; it separates nothing.
+    if (j == k || modes[j].kind != EigenvalueKind::finite || !std::isfinite(modes[j].error_bound)) continue;
     const double gap = std::abs(modes[k].lambda - modes[j].lambda);
     const double scale = std::max(std::abs(modes[k].lambda), std::abs(modes[j].lambda));
     if (gap <= modes[k].error_bound + modes[j].error_bound + 8 * u * scale) return false;
@@ -56,7 +57,7 @@ std::vector<std::vector<EigenvalueSensitivity>> eigenvalue_sensitivities(
   std::vector<std::vector<EigenvalueSensitivity>> out(modes.size());
   for (std::size_t k = 0; k < modes.size(); ++k) {
     const Mode& mode = modes[k];
-    const char* why = mode.kind == EigenvalueKind::zero       ? "zero"
+    const char* why = mode.kind == EigenvalueKind::zero || mode.zero_within_bound ? "zero"
                       : mode.kind == EigenvalueKind::infinite ? "infinite"
                       : mode.defective                         ? "defective"
                       : !separated(modes, k)                   ? "repeated"

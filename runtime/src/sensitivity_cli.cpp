@@ -36,7 +36,7 @@ void write_modes_sensitivity(std::ostream& out, const GeneratedModel& model, con
   if (json) out << "{\"model\": " << json_string(model.kernels().model) << ", \"modes\": [";
   else if (format == "csv")
     out << "mode,lambda_re,lambda_im,frequency_hz,damping_ratio,parameter,value,dlambda_re,dlambda_im,"
-           "relative_frequency,dfrequency_hz,ddamping_ratio,note\n";
+           "relative_frequency,dfrequency_hz,ddamping_ratio,relative_re,relative_im,note\n";
   else
     out << pad("mode", 5) << pad("f_n [Hz]", 14) << pad("parameter", 22) << pad("(p/f) df/dp", 15)
         << pad("d zeta/dp", 15) << pad("Re dlambda/dp", 15) << pad("Im dlambda/dp", 15) << "note\n";
@@ -59,14 +59,16 @@ void write_modes_sensitivity(std::ostream& out, const GeneratedModel& model, con
             << num(d[j].value, true) << ", \"dlambda\": [" << num(e.dlambda.real(), true) << ", "
             << num(e.dlambda.imag(), true) << "], \"relative_frequency\": " << num(e.relative_frequency, true)
             << ", \"dfrequency_hz\": " << num(e.dfrequency_hz, true) << ", \"ddamping_ratio\": "
-            << num(e.ddamping_ratio, true) << ", \"defined\": " << (e.defined ? "true" : "false")
+            << num(e.ddamping_ratio, true) << ", \"relative\": [" << num(e.relative.real(), true) << ", "
+            << num(e.relative.imag(), true) << "], \"defined\": " << (e.defined ? "true" : "false")
             << ", \"note\": " << json_string(e.note) << "}";
       } else if (format == "csv") {
         out << index << "," << num(m.lambda.real(), false) << "," << num(m.lambda.imag(), false) << ","
             << num(m.natural_frequency_hz, false) << "," << num(m.damping_ratio, false) << ","
             << csv_name(d[j].parameter) << "," << num(d[j].value, false) << "," << num(e.dlambda.real(), false) << ","
             << num(e.dlambda.imag(), false) << "," << num(e.relative_frequency, false) << ","
-            << num(e.dfrequency_hz, false) << "," << num(e.ddamping_ratio, false) << "," << e.note << "\n";
+            << num(e.dfrequency_hz, false) << "," << num(e.ddamping_ratio, false) << "," << num(e.relative.real(), false)
+            << "," << num(e.relative.imag(), false) << "," << e.note << "\n";
       } else {
         out << pad(std::to_string(index), 5) << pad(short_num(m.natural_frequency_hz), 14) << pad(d[j].parameter, 22)
             << pad(short_num(e.relative_frequency), 15) << pad(short_num(e.ddamping_ratio), 15)

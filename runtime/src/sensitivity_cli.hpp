@@ -19,7 +19,8 @@ void write_modes_sensitivity(std::ostream& out, const GeneratedModel& model, con
 
 /// The frequency response of one output to one input and its sensitivities at the frequencies
 /// hz: per parameter the relative magnitude sensitivity d ln|ẑ|/d ln p = Re((p/ẑ) dẑ/dp), the
-/// phase sensitivity d arg ẑ/d ln p = Im((p/ẑ) dẑ/dp) (rad) and dẑ/dp itself (csv, json).
+/// phase sensitivity d arg ẑ/d ln p = Im((p/ẑ) dẑ/dp) (rad) and dẑ/dp itself (csv, json; the
+/// table gives the relative magnitude sensitivities only).
 void write_frf_sensitivity(std::ostream& out, const GeneratedModel& model, Eigen::Index input, Eigen::Index output,
                            const Eigen::VectorXd& hz, const std::vector<std::string>& parameters,
                            const std::string& format);

@@ -98,6 +98,9 @@ int run_descriptor_modes(const GeneratedModel& model, const Options& o, std::ost
 
 int run_modes(const ModelKernels& k, const Options& o, std::ostream& out) {
   GeneratedModel model = configured(k, o);
+  if (model.is_descriptor() && o.sensitivity_given)
+    throw Error("modes --sensitivity: model '" + std::string(k.model) + "' has rolling constraints; sensitivities "
+                "are not available for it");
   if (model.is_descriptor()) return run_descriptor_modes(model, o, out);
   if (o.sensitivity_given) {
     write_modes_sensitivity(out, model, o.sensitivity, o.format, o.all);

@@ -4,7 +4,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
@@ -118,10 +120,11 @@ StudyResults evaluate(const GeneratedModel& model, const StudyDesign& design, co
 
   auto run_one = [&](Worker& w, std::size_t local) {
     const std::size_t index = first + local;
-    std::vector<double> values = design.point(index);
-    for (std::size_t k = 0; k < slot.size(); ++k) w.parameters[slot[k]] = values[k];
+    std::vector<double> values(slot.size());
     double* scalars = r.scalars.data() + local * ns;
     try {
+      design.point(index, values.data());
+      for (std::size_t k = 0; k < slot.size(); ++k) w.parameters[slot[k]] = values[k];
       auto t0 = std::chrono::steady_clock::now();
       w.model.set_parameters(w.parameters);
       const LinearModel lin = w.model.linear_model(w.model.operating_point());
@@ -145,7 +148,7 @@ StudyResults evaluate(const GeneratedModel& model, const StudyDesign& design, co
       std::fill(scalars, scalars + ns, kNaN);
       std::fill(r.sweep.begin() + static_cast<std::ptrdiff_t>(local * nw),
                 r.sweep.begin() + static_cast<std::ptrdiff_t>((local + 1) * nw), kNaN);
-      w.failures.push_back({index, values, e.what()});
+      w.failures.push_back({index, values, e.what()});  // (out of memory here ends the worker: below)
     }
   };
 
@@ -155,26 +158,44 @@ StudyResults evaluate(const GeneratedModel& model, const StudyDesign& design, co
   for (std::size_t t = 0; t < n_threads; ++t) workers.push_back({model, model.parameters(), 0, 0, 0, {}});
   std::atomic<std::size_t> next{0}, done{0};
   constexpr std::size_t kChunk = 8;
+  // A worker that cannot go on (out of memory while recording a failure) stops every worker and
+  // its exception is rethrown here; nothing escapes a thread.
+  std::exception_ptr stopped;
+  std::mutex stopped_lock;
   auto work = [&](Worker& w) {
-    for (std::size_t begin; (begin = next.fetch_add(kChunk)) < count;) {
-      const std::size_t end = std::min(count, begin + kChunk);
-      for (std::size_t i = begin; i < end; ++i) run_one(w, i);
-      done += end - begin;
+    try {
+      for (std::size_t begin; (begin = next.fetch_add(kChunk)) < count;) {
+        const std::size_t end = std::min(count, begin + kChunk);
+        for (std::size_t i = begin; i < end; ++i) run_one(w, i);
+        done += end - begin;
+      }
+    } catch (...) {
+      next = count;
+      done = count;
+      const std::lock_guard<std::mutex> guard(stopped_lock);
+      if (!stopped) stopped = std::current_exception();
     }
   };
   // With a progress report the calling thread only reports; otherwise it works too.
   std::vector<std::thread> pool;
-  for (std::size_t t = progress ? 0 : 1; t < n_threads; ++t) pool.emplace_back(work, std::ref(workers[t]));
-  if (progress) {
-    while (done.load() < count) {
-      progress(done.load());
-      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  try {
+    for (std::size_t t = progress ? 0 : 1; t < n_threads; ++t) pool.emplace_back(work, std::ref(workers[t]));
+    if (progress) {
+      while (done.load() < count) {
+        progress(done.load());
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      }
+      progress(count);
+    } else {
+      work(workers[0]);
     }
-    progress(count);
-  } else {
-    work(workers[0]);
+  } catch (...) {  // a thread that could not start, or a progress report that threw
+    next = count;
+    for (auto& t : pool) t.join();
+    throw;
   }
   for (auto& t : pool) t.join();
+  if (stopped) std::rethrow_exception(stopped);
   for (auto& w : workers) {
     r.seconds_kernels += w.kernels, r.seconds_modes += w.modes, r.seconds_response += w.response;
     r.failures.insert(r.failures.end(), w.failures.begin(), w.failures.end());

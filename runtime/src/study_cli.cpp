@@ -6,6 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
+#include <memory>
+#include <limits>
 #include <sstream>
 #include <thread>
 
@@ -53,7 +56,7 @@ struct Study {
 };
 
 std::string banner(const Study& s) {
-  return std::string("# ") + kMarker + ": model " + s.k.model + " (scene " + s.k.scene + "), " +
+  return std::string("# ") + kMarker + ": model " + csv_text(s.k.model) + " (scene " + csv_text(s.k.scene) + "), " +
          design_name(s.design.design()) + " design, seed " + std::to_string(s.design.seed()) + ", " +
          std::to_string(s.design.size()) + " evaluations\n";
 }
@@ -90,7 +93,8 @@ std::string bands_text(const Study& s, const std::vector<std::vector<double>>& b
     c << "}}\n";
     return c.str();
   }
-  c << banner(s) << "# |" << s.q.output << " / " << s.q.input << "|: percentiles over the evaluations that did not fail\n";
+  c << banner(s) << "# " << csv_text("|" + s.q.output + " / " + s.q.input + "|")
+    << ": percentiles over the evaluations that did not fail\n";
   c << "frequency_hz,p5,p25,p50,p75,p95\n";
   for (std::size_t i = 0; i < s.q.sweep_hz.size(); ++i) {
     c << num(s.q.sweep_hz[i], false);
@@ -133,7 +137,12 @@ std::vector<SobolResult> sobol_of(const Study& s) {
   for (std::size_t q = 0; q < ns; ++q) {
     std::vector<double> f(s.results.count);
     for (std::size_t i = 0; i < s.results.count; ++i) f[i] = s.results.scalars[i * ns + q];
-    out.push_back(sobol_indices(f, n, d, static_cast<std::size_t>(s.o.bootstrap), s.design.seed() ^ 0x50b01ULL));
+    try {
+      out.push_back(sobol_indices(f, n, d, static_cast<std::size_t>(s.o.bootstrap), s.design.seed() ^ 0x50b01ULL));
+    } catch (const Error&) {  // fewer than 2 rows without a failure: no indices (NaN), the failures say why
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      out.push_back({std::vector<SobolIndex>(d, SobolIndex{nan, nan, nan, nan, nan, nan}), 0, nan});
+    }
   }
   return out;
 }
@@ -239,7 +248,8 @@ CLI::App* add_study(CLI::App& app, StudyOptions& o) {
   s->add_option("--points", o.points, "frequencies of the band (0: none)")->check(CLI::Range(0L, 100000L));
   s->add_option("--spacing", o.spacing, "frequency spacing")->check(CLI::IsMember({"log", "linear"}));
   s->add_option("--at", o.at_hz, "response levels (dB) at these frequencies [Hz], for statistics and Sobol' indices")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(frequency_hz());
   s->add_option("--method", o.method, "frequency-response method");
   s->add_option("--threads", o.threads, "threads per process (default: the cores, shared by the processes)")
       ->check(CLI::Range(0, 4096));
@@ -280,32 +290,72 @@ StudyQuantities quantities(const ModelKernels& k, const StudyOptions& o) {
 
 }  // namespace
 
-int run_study(const ModelKernels& k, StudyOptions o, std::ostream& out, std::ostream& err) {
-  Cluster cluster;
-  GeneratedModel model(k);
+namespace {
+
+// Everything before the evaluations: the model's parameters, the design, the quantities, and the
+// checks that can fail (on rank 0, the files it will write). Throws what a bad option gives.
+std::unique_ptr<Study> prepare(const ModelKernels& k, const StudyOptions& o, GeneratedModel& model,
+                               const Cluster& cluster) {
   for (const auto& a : o.set) model.set(a);
   std::vector<ParameterDistribution> dists;
   for (const auto& p : o.parameters) dists.push_back(parse_distribution(p));
   const Design design_kind = parse_design(o.design);
-  Study s{k, o, StudyDesign(design_kind, dists, static_cast<std::size_t>(o.samples), o.seed), quantities(k, o), {}, 0, 1, ""};
-  if (design_kind == Design::saltelli && scalar_names(s.q).empty())
+  auto s = std::make_unique<Study>(Study{k, o, StudyDesign(design_kind, dists, static_cast<std::size_t>(o.samples), o.seed),
+                                         quantities(k, o), {}, 0, 1, ""});
+  if (design_kind == Design::saltelli && scalar_names(s->q).empty())
     throw Error("study: Sobol' indices (saltelli) need scalar quantities: --modes K or --at FREQUENCIES");
   if (design_kind != Design::saltelli && !o.sobol_file.empty())
     throw Error("study: --sobol needs the saltelli design");
-  if ((!o.bands_file.empty() || !o.plot.empty()) && s.q.sweep_hz.empty())
+  if ((!o.bands_file.empty() || !o.plot.empty()) && s->q.sweep_hz.empty())
     throw Error("study: --bands and --plot need a response band (--input, --output and --points > 0)");
-  for (const auto* f : {&o.samples_file, &o.bands_file, &o.sobol_file, &o.plot})
-    if (!f->empty()) refuse_special_file(*f, "study");
+  const std::string ext = std::filesystem::path(o.plot).extension().string();
+  if (!o.plot.empty() && ext != ".svg" && ext != ".png")
+    throw Error("study: --plot " + o.plot + ": the file name must end in .svg or .png");
+  // One gather (MPI_Gatherv) carries at most 2^31 − 1 values of each kind.
+  const std::size_t values = s->design.size() * std::max(s->q.sweep_hz.size(), scalar_names(s->q).size());
+  if (cluster.size() > 1 && values > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw Error("study: " + std::to_string(s->design.size()) + " evaluations of " +
+                std::to_string(values / s->design.size()) + " values are more than one MPI gather carries "
+                "(2^31 - 1 values): run fewer samples per study, or fewer --points");
+  if (cluster.rank() == 0) {  // the files, before the work: not after hours of it
+    std::vector<std::filesystem::path> data;
+    for (const auto* f : {&o.samples_file, &o.bands_file, &o.sobol_file, &o.plot})
+      if (!f->empty()) refuse_special_file(*f, "study");
+    for (const auto* f : {&o.samples_file, &o.bands_file, &o.sobol_file})
+      if (!f->empty()) data.push_back(*f);
+    refuse_foreign_files(data, kMarker, "study");
+  }
+  const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  s->threads = o.threads > 0 ? o.threads : std::max(1, hw / cluster.local_size());
+  s->where = std::to_string(s->threads) + (s->threads == 1 ? " thread" : " threads") + " per process, " +
+             cluster.description();
+  return s;
+}
 
+}  // namespace
+
+int run_study(const ModelKernels& k, StudyOptions o, std::ostream& out, std::ostream& err) {
+  Cluster cluster;
+  GeneratedModel model(k);
+  std::unique_ptr<Study> study;
+  std::exception_ptr problem;
+  // Every rank checks the same options, and all stop together when one of them cannot go on
+  // (an exception on one rank alone must not leave the others waiting in a collective call).
+  try {
+    study = prepare(k, o, model, cluster);
+  } catch (...) {
+    problem = std::current_exception();
+  }
+  if (cluster.any(problem != nullptr)) {
+    if (problem) std::rethrow_exception(problem);
+    return 1;
+  }
+  Study& s = *study;
   const std::size_t total = s.design.size();
   const std::size_t begin = total * static_cast<std::size_t>(cluster.rank()) / static_cast<std::size_t>(cluster.size());
   const std::size_t end = total * static_cast<std::size_t>(cluster.rank() + 1) / static_cast<std::size_t>(cluster.size());
-  const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  s.threads = o.threads > 0 ? o.threads : std::max(1, hw / cluster.local_size());
-  s.where = std::to_string(s.threads) + (s.threads == 1 ? " thread" : " threads") + " per process, " + cluster.description();
   const bool progress = cluster.rank() == 0 && total >= 200 && ::isatty(STDERR_FILENO);
   const auto t0 = std::chrono::steady_clock::now();
-  std::exception_ptr problem;
   StudyResults local;
   try {
     local = evaluate(model, s.design, s.q, begin, end - begin, s.threads, progress ? [&](std::size_t done) {
@@ -322,7 +372,7 @@ int run_study(const ModelKernels& k, StudyOptions o, std::ostream& out, std::ost
   s.results = cluster.gather(std::move(local));
   s.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (cluster.rank() != 0) return 0;
-  const std::vector<SobolResult> sobol = design_kind == Design::saltelli ? sobol_of(s) : std::vector<SobolResult>{};
+  const std::vector<SobolResult> sobol = s.design.design() == Design::saltelli ? sobol_of(s) : std::vector<SobolResult>{};
   write_summary(out, s, sobol);
   report_failures(err, s);
   write_outputs(s, sobol, err);

@@ -92,7 +92,9 @@ Cluster::Cluster() {
   int already = 0;
   MPI_Initialized(&already);
   if (!already) {
-    MPI_Init(nullptr, nullptr);
+    // The study's worker threads make no MPI calls; the main thread makes them all.
+    int provided = 0;
+    MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
     initialized_ = true;
   }
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);

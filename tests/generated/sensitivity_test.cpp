@@ -13,6 +13,12 @@
 #include <vector>
 
 #include "base_excited_oscillator_model.hpp"
+#include "chain3_sympy_model.hpp"
+#include "double_pendulum_model.hpp"
+#include "jeffcott_rotor_model.hpp"
+#include "rotor_disk_model.hpp"
+#include "spring_chain_fixed_fixed_model.hpp"
+#include "ziegler_column_model.hpp"
 #include "hp.hpp"
 #include "mbsgen/runtime/generated_model.hpp"
 #include "mbsgen/runtime/quadratic_eigen.hpp"
@@ -234,6 +240,59 @@ TEST(Sensitivity, MiddleEarResponseAgainstHighPrecision) {
                                         2 * M_PI * hz[n], v);
       EXPECT_LE(std::abs(r.derivative[j][n](v, P) - ref), 1e-9 * std::abs(ref)) << d[j].parameter << " at " << hz[n];
     }
+}
+
+// The textbook models, every parameter: (a) the kernel's total derivatives against central
+// differences of the whole pipeline — operating point found again (the spring chain's
+// equilibrium, by Newton; the rotor's steady spin rate Omega), linear model — at p ± h,
+// h = 1e-6 |p|: 1e-6 of the matrix's scale per unit of p, the differences' own truncation and
+// rounding; (b) dλ/dp of every finite, simple mode against 80-digit central differences of the
+// eigenvalues along the kernel's derivatives: 1e-9 relative plus 1e-13 |λ|/|p|, as for the middle
+// ear. Models: a double pendulum, SymPy's three-link chain, a spring chain at its equilibrium
+// under gravity, a Jeffcott rotor with rotating damping (circulatory K), a spinning rotor disk
+// (gyroscopic Q about a steady motion) and Ziegler's follower-force column.
+TEST(Sensitivity, TextbookModelsAgainstCentralDifferences) {
+  for (const mbsgen::ModelKernels* k : {&double_pendulum::kernels(), &chain3_sympy::kernels(),
+                                        &spring_chain_fixed_fixed::kernels(), &jeffcott_rotor::kernels(),
+                                        &rotor_disk::kernels(), &ziegler_column::kernels()}) {
+    SCOPED_TRACE(k->model);
+    GeneratedModel model(*k);
+    ASSERT_TRUE(model.has_sensitivities());
+    const auto op = model.operating_point();
+    const auto lin = model.linear_model(op);
+    const auto d = model.linear_sensitivities(op);
+    for (const auto& dj : d) {
+      if (dj.value == 0) continue;
+      const double h = 1e-6 * std::abs(dj.value);
+      auto at = [&](double v) {
+        GeneratedModel q(*k);
+        q.set(dj.parameter, v);
+        return q.linear_model(q.operating_point());
+      };
+      const auto plus = at(dj.value + h), minus = at(dj.value - h);
+      auto check = [&](const Eigen::MatrixXd& dA, const Eigen::MatrixXd& Ap, const Eigen::MatrixXd& Am,
+                       const Eigen::MatrixXd& A, const char* what) {
+        const double scale = std::max(A.cwiseAbs().maxCoeff(), 1e-300) / std::abs(dj.value);
+        EXPECT_LE((dA - (Ap - Am) / (2 * h)).cwiseAbs().maxCoeff(), 1e-6 * scale) << what << " by " << dj.parameter;
+      };
+      check(dj.M, plus.M(), minus.M(), lin.M(), "M");
+      check(dj.Q, plus.Q(), minus.Q(), lin.Q(), "Q");
+      check(dj.K, plus.K(), minus.K(), lin.K(), "K");
+    }
+    const auto modes = modes_of(lin);
+    const auto s = mbsgen::eigenvalue_sensitivities(lin, modes, d);
+    int checked = 0;
+    for (std::size_t m = 0; m < modes.size(); ++m)
+      for (std::size_t j = 0; j < d.size(); ++j) {
+        if (!s[m][j].defined || d[j].value == 0) continue;
+        const cd ref = hp::eigenvalue_derivative(lin.M(), lin.Q(), lin.K(), d[j].M, d[j].Q, d[j].K, modes[m].lambda,
+                                                 modes[m].shape);
+        const double floor = 1e-13 * std::abs(modes[m].lambda) / std::abs(d[j].value);
+        EXPECT_LE(std::abs(s[m][j].dlambda - ref), 1e-9 * std::abs(ref) + floor) << "mode " << m << " by " << d[j].parameter;
+        ++checked;
+      }
+    EXPECT_GT(checked, 0);
+  }
 }
 
 // A repeated eigenvalue (two equal, uncoupled oscillators) and a defective one (a critically

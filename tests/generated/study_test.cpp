@@ -202,6 +202,21 @@ TEST(Study, SolverCommandLine) {
   EXPECT_EQ(run({"study", "--parameter", "k=uniform:1:2", "--samples", "8", "--modes", "1", "--sobol", dir + "/x.csv"},
                 out, err), 1);
   EXPECT_NE(err.find("--sobol needs the saltelli design"), std::string::npos) << err;
+  // A file mbsgen did not write is refused before the evaluations, and left as it was.
+  {
+    std::ofstream(dir + "/mine.csv") << "my data\n";
+  }
+  EXPECT_EQ(run({"study", "--parameter", "k=uniform:1:2", "--samples", "8", "--modes", "1", "--write-samples",
+                 dir + "/mine.csv"}, out, err), 1);
+  EXPECT_NE(err.find("refusing to overwrite"), std::string::npos) << err;
+  EXPECT_EQ(out, "");  // nothing was evaluated
+  EXPECT_EQ(read(dir + "/mine.csv"), "my data\n");
+  // Every evaluation failing (a negative mass): the failures are reported, no Sobol' index is
+  // made up, exit status 1.
+  EXPECT_EQ(run({"study", "--parameter", "m=uniform:-2:-1", "--samples", "8", "--modes", "1", "--design", "saltelli"},
+                out, err), 1);
+  EXPECT_NE(err.find("24 of 24 evaluations failed"), std::string::npos) << err;
+  EXPECT_NE(out.find("f1_hz"), std::string::npos) << out;
 }
 
 }  // namespace

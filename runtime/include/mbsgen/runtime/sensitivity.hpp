@@ -44,7 +44,8 @@ struct MatrixSensitivity {
 /// dλ/dp of one eigenvalue for one parameter.
 struct EigenvalueSensitivity {
   bool defined = false;         ///< false: the eigenvalue is not simple (see note); values NaN
-  std::string note;             ///< why not defined: "defective", "repeated", "zero", "infinite"
+  std::string note;             ///< why not defined: "defective", "repeated", "zero" (also zero
+                                ///< within its error bound), "infinite"
   std::complex<double> dlambda; ///< dλ/dp (1/s per unit of p)
   std::complex<double> relative;///< (p/λ) dλ/dp
   double dfrequency_hz = 0;     ///< d(|λ|/2π)/dp
