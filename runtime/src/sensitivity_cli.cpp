@@ -32,6 +32,20 @@ void write_modes_sensitivity(std::ostream& out, const GeneratedModel& model, con
   solver.compute(lin);
   const std::vector<Mode>& modes = solver.modes();
   const auto s = eigenvalue_sensitivities(lin, modes, d);
+  // The modes as `modes` lists them (one per conjugate pair, a rigid-body double zero once,
+  // unless --all), each with its place in the full list: the same numbering as `modes`.
+  opt.one_per_conjugate_pair = !all;
+  QuadraticEigenSolver listed(lin.size(), opt);
+  listed.compute(lin);
+  std::vector<std::size_t> order;
+  std::vector<bool> used(modes.size(), false);
+  for (const Mode& m : listed.modes())
+    for (std::size_t k = 0; k < modes.size(); ++k)
+      if (!used[k] && modes[k].kind == m.kind && modes[k].lambda == m.lambda) {
+        used[k] = true;
+        order.push_back(k);
+        break;
+      }
   const bool json = format == "json";
   if (json) out << "{\"model\": " << json_string(model.kernels().model) << ", \"modes\": [";
   else if (format == "csv")
@@ -42,9 +56,8 @@ void write_modes_sensitivity(std::ostream& out, const GeneratedModel& model, con
         << pad("d zeta/dp", 15) << pad("Re dlambda/dp", 15) << pad("Im dlambda/dp", 15) << "note\n";
   int index = 0;
   bool first_mode = true;
-  for (std::size_t k = 0; k < modes.size(); ++k) {
+  for (std::size_t k : order) {
     const Mode& m = modes[k];
-    if (!all && m.kind == EigenvalueKind::finite && m.lambda.imag() < 0) continue;  // one per pair
     ++index;
     if (json)
       out << (first_mode ? "" : ",") << "\n  {\"mode\": " << index << ", \"lambda\": [" << num(m.lambda.real(), true)

@@ -18,6 +18,7 @@
 #include "jeffcott_rotor_model.hpp"
 #include "rotor_disk_model.hpp"
 #include "spring_chain_fixed_fixed_model.hpp"
+#include "spring_chain_free_free_model.hpp"
 #include "ziegler_column_model.hpp"
 #include "hp.hpp"
 #include "mbsgen/runtime/generated_model.hpp"
@@ -367,6 +368,14 @@ TEST(Sensitivity, SolverCommandLine) {
                  "/tmp/never.svg"},
                 out, err), 1);
   EXPECT_NE(err.find("--plot"), std::string::npos) << err;
+  // The modes are numbered as `modes` numbers them: the spring chain with free ends has a
+  // rigid-body double zero, listed once.
+  ASSERT_EQ(run(spring_chain_free_free::kernels(), {"modes", "--format", "csv"}, out, err), 0) << err;
+  const auto rows = std::count(out.begin(), out.end(), '\n') - 1;
+  ASSERT_EQ(run(spring_chain_free_free::kernels(), {"modes", "--sensitivity", "k", "--format", "csv"}, out, err), 0)
+      << err;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n') - 1, rows) << out;
+  EXPECT_NE(out.find("\n" + std::to_string(rows) + ","), std::string::npos) << out;
 }
 
 }  // namespace
