@@ -66,6 +66,12 @@ std::string pad(const std::string& s, std::size_t w) {
   return s.size() >= w ? s : std::string(w - s.size(), ' ') + s;
 }
 
+std::string csv_field(const std::string& s) {
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' || c == '\r' ? ' ' : c);
+  return q + "\"";
+}
+
 std::string json_string(const std::string& s) {
   std::string o = "\"";
   for (char c : s) {

@@ -49,6 +49,9 @@ Eigen::VectorXd sweep_hz(double from_hz, double to_hz, long points, bool log_spa
 std::string pad(const std::string& s, std::size_t w);
 /// A JSON string literal.
 std::string json_string(const std::string& s);
+/// s as a CSV field: quoted, quotes doubled, line breaks as spaces (a model's names and error
+/// messages are data: a comma, quote or newline in them must not shift the columns or lines).
+std::string csv_field(const std::string& s);
 
 struct ModesFormat {
   std::string format = "table";                  // table | json | csv

@@ -9,17 +9,6 @@
 
 namespace mbsgen::cli {
 
-namespace {
-
-// A field of a CSV line: names are quoted (a model's names are data: a comma or a quote in them
-// must not shift the columns).
-std::string csv_name(const std::string& s) {
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-}  // namespace
 
 void write_modes_sensitivity(std::ostream& out, const GeneratedModel& model, const std::vector<std::string>& parameters,
                              const std::string& format, bool all) {
@@ -78,7 +67,7 @@ void write_modes_sensitivity(std::ostream& out, const GeneratedModel& model, con
       } else if (format == "csv") {
         out << index << "," << num(m.lambda.real(), false) << "," << num(m.lambda.imag(), false) << ","
             << num(m.natural_frequency_hz, false) << "," << num(m.damping_ratio, false) << ","
-            << csv_name(d[j].parameter) << "," << num(d[j].value, false) << "," << num(e.dlambda.real(), false) << ","
+            << csv_field(d[j].parameter) << "," << num(d[j].value, false) << "," << num(e.dlambda.real(), false) << ","
             << num(e.dlambda.imag(), false) << "," << num(e.relative_frequency, false) << ","
             << num(e.dfrequency_hz, false) << "," << num(e.ddamping_ratio, false) << "," << num(e.relative.real(), false)
             << "," << num(e.relative.imag(), false) << "," << e.note << "\n";
@@ -113,8 +102,8 @@ void write_frf_sensitivity(std::ostream& out, const GeneratedModel& model, Eigen
     out << "frequency_hz,re,im,magnitude,phase_rad";
     for (const auto& x : d) {
       const std::string n = x.parameter;
-      out << "," << csv_name("dlnmag/dlnp:" + n) << "," << csv_name("dphase/dlnp:" + n) << "," << csv_name("dre/dp:" + n)
-          << "," << csv_name("dim/dp:" + n);
+      out << "," << csv_field("dlnmag/dlnp:" + n) << "," << csv_field("dphase/dlnp:" + n) << "," << csv_field("dre/dp:" + n)
+          << "," << csv_field("dim/dp:" + n);
     }
     out << "\n";
   } else {

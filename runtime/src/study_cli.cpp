@@ -27,12 +27,6 @@ namespace {
 constexpr const char* kMarker = "mbsgen study";
 const std::vector<double> kPercentiles = {5, 25, 50, 75, 95};
 
-// A CSV field: quoted, quotes doubled (a model's names and error messages are data).
-std::string csv_text(const std::string& s) {
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
-  return q + "\"";
-}
 
 bool is_json(const std::string& path) {
   return path.size() >= 5 && path.compare(path.size() - 5, 5, ".json") == 0;
@@ -56,7 +50,7 @@ struct Study {
 };
 
 std::string banner(const Study& s) {
-  return std::string("# ") + kMarker + ": model " + csv_text(s.k.model) + " (scene " + csv_text(s.k.scene) + "), " +
+  return std::string("# ") + kMarker + ": model " + csv_field(s.k.model) + " (scene " + csv_field(s.k.scene) + "), " +
          design_name(s.design.design()) + " design, seed " + std::to_string(s.design.seed()) + ", " +
          std::to_string(s.design.size()) + " evaluations\n";
 }
@@ -64,7 +58,7 @@ std::string banner(const Study& s) {
 std::string samples_csv(const Study& s) {
   std::ostringstream c;
   c << banner(s) << "index";
-  for (const auto& d : s.design.distributions()) c << "," << csv_text(d.name);
+  for (const auto& d : s.design.distributions()) c << "," << csv_field(d.name);
   for (const auto& n : s.results.scalar_names) c << "," << n;
   c << ",status\n";
   std::size_t f = 0;
@@ -76,7 +70,7 @@ std::string samples_csv(const Study& s) {
     for (double v : values) c << "," << num(v, false);
     for (std::size_t j = 0; j < ns; ++j) c << "," << num(s.results.scalars[i * ns + j], false);
     const bool failed = f < s.results.failures.size() && s.results.failures[f].index == i;
-    c << "," << (failed ? csv_text(s.results.failures[f++].message) : std::string("ok")) << "\n";
+    c << "," << (failed ? csv_field(s.results.failures[f++].message) : std::string("ok")) << "\n";
   }
   return c.str();
 }
@@ -93,7 +87,7 @@ std::string bands_text(const Study& s, const std::vector<std::vector<double>>& b
     c << "}}\n";
     return c.str();
   }
-  c << banner(s) << "# " << csv_text("|" + s.q.output + " / " + s.q.input + "|")
+  c << banner(s) << "# " << csv_field("|" + s.q.output + " / " + s.q.input + "|")
     << ": percentiles over the evaluations that did not fail\n";
   c << "frequency_hz,p5,p25,p50,p75,p95\n";
   for (std::size_t i = 0; i < s.q.sweep_hz.size(); ++i) {
@@ -120,7 +114,7 @@ std::string sobol_text(const Study& s, const std::vector<SobolResult>& sobol, bo
           << ", " << num(x.first_low, true) << ", " << num(x.first_high, true) << "], \"total\": [" << num(x.total, true)
           << ", " << num(x.total_low, true) << ", " << num(x.total_high, true) << "]}";
       else
-        c << s.results.scalar_names[q] << "," << csv_text(dists[j].name) << "," << num(x.first, false) << ","
+        c << s.results.scalar_names[q] << "," << csv_field(dists[j].name) << "," << num(x.first, false) << ","
           << num(x.first_low, false) << "," << num(x.first_high, false) << "," << num(x.total, false) << ","
           << num(x.total_low, false) << "," << num(x.total_high, false) << "," << sobol[q].rows_used << "\n";
     }
@@ -277,9 +271,9 @@ StudyQuantities quantities(const ModelKernels& k, const StudyOptions& o) {
   if (response && o.points > 0) {
     double from = o.from, to = o.to;
     if (from == 0 && to == 0) from = k.default_from_hz, to = k.default_to_hz;
-    const std::string problem = sweep_problem(from, to, o.points, o.spacing == "log");
     if (from == 0 && to == 0)
       throw Error("study: the band needs --from and --to (the scene gives no frequency range), or --points 0");
+    const std::string problem = sweep_problem(from, to, o.points, o.spacing == "log");
     if (!problem.empty()) throw Error("study: " + problem);
     const Eigen::VectorXd hz = sweep_hz(from, to, o.points, o.spacing == "log");
     q.sweep_hz.assign(hz.data(), hz.data() + hz.size());
@@ -312,10 +306,11 @@ std::unique_ptr<Study> prepare(const ModelKernels& k, const StudyOptions& o, Gen
   if (!o.plot.empty() && ext != ".svg" && ext != ".png")
     throw Error("study: --plot " + o.plot + ": the file name must end in .svg or .png");
   // One gather (MPI_Gatherv) carries at most 2^31 − 1 values of each kind.
-  const std::size_t values = s->design.size() * std::max(s->q.sweep_hz.size(), scalar_names(s->q).size());
+  const std::size_t per_evaluation = std::max(s->q.sweep_hz.size(), scalar_names(s->q).size());
+  const std::size_t values = s->design.size() * per_evaluation;
   if (cluster.size() > 1 && values > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     throw Error("study: " + std::to_string(s->design.size()) + " evaluations of " +
-                std::to_string(values / s->design.size()) + " values are more than one MPI gather carries "
+                std::to_string(per_evaluation) + " values are more than one MPI gather carries "
                 "(2^31 - 1 values): run fewer samples per study, or fewer --points");
   if (cluster.rank() == 0) {  // the files, before the work: not after hours of it
     std::vector<std::filesystem::path> data;
