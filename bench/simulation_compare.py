@@ -102,7 +102,7 @@ def main():
         for r in csv.DictReader(f):
             t, y = read_samples(os.path.join(results, "ours_%s_%s_%g.csv" % (r["problem"], r["method"], float(r["rtol"]))))
             _, ref = read_samples(os.path.join(results, "reference_%s.csv" % r["problem"]))
-            out.append((r["problem"], "mbsgen " + r["method"].upper().replace("ADAMS", "Adams"), float(r["rtol"]),
+            out.append((r["problem"], "mbsgen " + r["method"].upper().replace("ADAMS", "Adams").replace("RADAU", "Radau"), float(r["rtol"]),
                         float(r["seconds"]), error(y, ref)))
     work = tempfile.mkdtemp(prefix="mbsgen-scipy-")
     for name, (model_id, duration, step, initial, tone, atol_scale, rtols) in PROBLEMS.items():

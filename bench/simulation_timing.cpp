@@ -87,9 +87,11 @@ int main(int argc, char** argv) {
       o.atol = o.rtol * p.atol_scale;
       write(dir + "/reference_" + p.name + ".csv", mbsgen::simulate(model, op, o));
     }
-    for (auto method : {mbsgen::IntegrationMethod::bdf, mbsgen::IntegrationMethod::adams}) {
+    for (auto method : {mbsgen::IntegrationMethod::bdf, mbsgen::IntegrationMethod::radau, mbsgen::IntegrationMethod::adams}) {
       if (stiff && method == mbsgen::IntegrationMethod::adams) continue;  // 160,000 steps: not its kind of problem
-      const char* name = method == mbsgen::IntegrationMethod::bdf ? "bdf" : "adams";
+      const char* name = method == mbsgen::IntegrationMethod::bdf     ? "bdf"
+                         : method == mbsgen::IntegrationMethod::radau ? "radau"
+                                                                      : "adams";
       // Every half decade, from 1e-4 to 1e-12 (the middle ear's 1e-10): the comparison pairs each
       // SciPy run with our fastest run at least as accurate, so a coarse grid would pair it with a
       // run up to a decade more accurate (and slower) than needed.

@@ -30,7 +30,9 @@ SimulationOptions simulation_options(const GeneratedModel& model, const Simulate
   s.rtol = o.rtol;
   s.atol = o.atol;
   s.difference_quotients = o.difference_quotients;
-  s.method = o.method == "adams" ? IntegrationMethod::adams : IntegrationMethod::bdf;
+  s.method = o.method == "adams"   ? IntegrationMethod::adams
+             : o.method == "radau" ? IntegrationMethod::radau
+                                   : IntegrationMethod::bdf;
   for (const std::string& a : o.initial) {
     const auto [name, text] = assignment(a, "--initial");
     s.initial.emplace_back(name, finite_number(text, "--initial '" + a + "'"));
@@ -142,7 +144,7 @@ void plot(const SimulateOptions& o, const ModelKernels& k, const SimulationResul
 void print_statistics(std::ostream& err, const SimulateOptions& o, const SimulationResult& r) {
   err << "simulate: " << r.t.size() << " samples, " << o.method << ", " << r.steps << " steps, " << r.rhs_evaluations
       << " right-hand sides";
-  if (o.method == "bdf")
+  if (o.method != "adams")
     err << ", " << r.jacobian_evaluations << " Jacobians (" << (r.analytic_jacobian ? "kernels" : "difference quotients")
         << ")";
   err << ", " << r.error_test_failures << " error test failures, " << r.nonlinear_failures
@@ -167,8 +169,9 @@ CLI::App* add_simulate(CLI::App& app, SimulateOptions& o) {
   s->add_option("--atol", o.atol, "absolute tolerance")->check(CLI::PositiveNumber);
   s->add_option("--atol-of", o.atol_of, "the absolute tolerance of one coordinate or rate, NAME=VALUE or "
                                         "NAME_dot=VALUE, in its units (states of different sizes); repeatable");
-  s->add_option("--method", o.method, "bdf (stiff models; the default) or adams (non-stiff motion: fewer, more "
-                                     "accurate steps)")->check(CLI::IsMember({"bdf", "adams"}));
+  s->add_option("--method", o.method, "bdf (stiff models; the default), radau (Radau IIA of order 5: stiff and "
+                                     "oscillating models, tighter tolerances) or adams (non-stiff motion: fewer, "
+                                     "more accurate steps)")->check(CLI::IsMember({"bdf", "radau", "adams"}));
   s->add_option("--format", o.format, "output format")->check(CLI::IsMember({"csv", "json"}));
   s->add_option("--plot", o.plot, "plot chosen series against time (FILE.svg or FILE.png)");
   s->add_option("--show", o.show, "the series to plot (default: the outputs); repeatable");
@@ -199,7 +202,7 @@ int run_simulate(const ModelKernels& k, const SimulateOptions& o, std::ostream& 
     err << "\rsimulate: t = " << short_num(t) << " s (" << static_cast<int>(100 * t / s.duration) << " %)" << std::flush;
     progress_shown = true;
   };
-  if (o.method == "bdf" && k.mass_matrix && k.residual && !k.dynamics_jacobian && !o.difference_quotients)
+  if (o.method != "adams" && k.mass_matrix && k.residual && !k.dynamics_jacobian && !o.difference_quotients)
     err << "note: the kernels have no dynamics_jacobian ("
         << (k.n_constraints > 0 ? "not emitted for closed loops" : "generate with --dynamics")
         << "): iteration matrices from difference quotients\n";

@@ -1,6 +1,7 @@
 // simulate(): SUNDIALS CVODE on x' = (v, −M(y)⁻¹ (k − q)(y, v, u(t))), x = (y, v) (simulation.hpp).
 #include "mbsgen/runtime/simulation.hpp"
 
+#include "radau.hpp"
 #include "second_order_newton.hpp"
 
 #include <cvode/cvode.h>
@@ -15,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -98,7 +100,7 @@ struct Cvode {
 
 // The model's equations at a state, through the generated kernels: M and k − q, the
 // accelerations ÿ = −M⁻¹ (k − q), and the Jacobian kernel.
-class Equations {
+class Equations : public detail::SecondOrderSystem {
  public:
   Equations(const GeneratedModel& model, const SimulationOptions& o)
       : k_(model.kernels()), p_(model.parameters()), n_(k_.n_coordinates), options_(o),
@@ -146,7 +148,7 @@ class Equations {
   Index size() const { return n_; }
   const ModelKernels& kernels() const { return k_; }
   bool analytic_jacobian() const {
-    return options_.method == IntegrationMethod::bdf && k_.dynamics_jacobian && !options_.difference_quotients;
+    return options_.method != IntegrationMethod::adams && k_.dynamics_jacobian && !options_.difference_quotients;
   }
 
   // The inputs at t; at the start of a segment (t = 0, or a breakpoint where the integrator
@@ -166,17 +168,7 @@ class Equations {
   // just after a restart at t.
   bool evaluate(double t, const double* y, const double* yd, bool signal_values = false) {
     if (signal_values) inputs_at(t); else inputs(t);
-    int s = 0;
-    if (follows_loops()) {
-      const double* tree = closed(y);
-      s = tree ? k_.dynamics_full(tree, yd, u_.data(), p_.data(), M_.data(), r_.data()) : 2;
-    } else if (k_.dynamics) {
-      s = k_.dynamics(y, yd, u_.data(), p_.data(), M_.data(), r_.data());
-    } else {
-      s = k_.mass_matrix(y, p_.data(), M_.data());
-      if (s == 0) s = k_.residual(y, yd, u_.data(), p_.data(), r_.data());
-    }
-    if (s != 0) return fail(t, s == 2 ? Failure::loops : Failure::non_finite);
+    if (!kernels(t, y, yd)) return false;
     if (!factor_mass()) return fail(t, Failure::singular_mass);
     // ÿ = −S (S M S)⁻¹ S (k − q)
     r_.array() *= scale_.array();
@@ -212,6 +204,27 @@ class Equations {
   const VectorXd& accelerations() const { return a_; }
   const std::vector<double>& parameters() const { return p_; }
 
+  // For Radau IIA (radau.hpp).
+  bool accelerations(double t, const double* y, const double* yd, VectorXd& a) override {
+    if (!evaluate(t, y, yd)) return false;
+    a = a_;
+    return true;
+  }
+  bool jacobian_mass(double t, const double* y, const double* yd, MatrixXd& M, VectorXd& a) override {
+    if (!evaluate(t, y, yd)) return false;
+    M = M_;
+    a = a_;
+    return true;
+  }
+  bool has_jacobian() const override { return analytic_jacobian(); }
+  bool jacobian(double t, const double* y, const double* yd, MatrixXd& M, MatrixXd& Ky, MatrixXd& Kv) override {
+    if (!evaluate(t, y, yd)) return false;
+    if (k_.dynamics_jacobian(y, yd, a_.data(), u_.data(), p_.data(), Ky.data(), Kv.data()) != 0)
+      return fail(t, Failure::non_finite);
+    M = M_;
+    return Ky.allFinite() && Kv.allFinite() ? true : fail(t, Failure::non_finite);
+  }
+
   enum class Failure { none, non_finite, loops, singular_mass, exception };
   Failure failure = Failure::none;  // the last failure in the current CVode call, for the message
   double failed_time = 0;
@@ -235,6 +248,21 @@ class Equations {
   }
 
  private:
+  // M and k − q at (y, ẏ) and the inputs u_.
+  bool kernels(double t, const double* y, const double* yd) {
+    int s = 0;
+    if (follows_loops()) {
+      const double* tree = closed(y);
+      s = tree ? k_.dynamics_full(tree, yd, u_.data(), p_.data(), M_.data(), r_.data()) : 2;
+    } else if (k_.dynamics) {
+      s = k_.dynamics(y, yd, u_.data(), p_.data(), M_.data(), r_.data());
+    } else {
+      s = k_.mass_matrix(y, p_.data(), M_.data());
+      if (s == 0) s = k_.residual(y, yd, u_.data(), p_.data(), r_.data());
+    }
+    if (s != 0) return fail(t, s == 2 ? Failure::loops : Failure::non_finite);
+    return r_.allFinite() && M_.allFinite() ? true : fail(t, Failure::non_finite);
+  }
   bool fail(double t, Failure f) {
     failure = f;
     failed_time = t;
@@ -489,19 +517,6 @@ void record(SimulationResult& r, Index j, double t, const double* x, Equations& 
   if (status != 0) throw SimulationError("simulate: the outputs are not finite " + at_time(t), t);
 }
 
-void add_statistics(Cvode& cv, SimulationResult& r) {
-  long v = 0;
-  CVodeGetNumSteps(cv.mem, &v), r.steps += v;
-  CVodeGetNumRhsEvals(cv.mem, &v), r.rhs_evaluations += v;
-  if (cv.solver) {
-    CVodeGetNumJacEvals(cv.mem, &v), r.jacobian_evaluations += v;
-    CVodeGetNumLinRhsEvals(cv.mem, &v), r.rhs_evaluations += v;  // difference-quotient Jacobians
-  }
-  CVodeGetNumErrTestFails(cv.mem, &v), r.error_test_failures += v;
-  CVodeGetNumNonlinSolvConvFails(cv.mem, &v), r.nonlinear_failures += v;
-}
-
-
 SimulationResult allocated(const ModelKernels& k, Index samples) {
   SimulationResult r;
   r.t.resize(samples);
@@ -542,21 +557,134 @@ std::vector<Stop> stop_times(const SimulationOptions& o) {
   return stops;
 }
 
-// After a jump of an input at t: the new segment's inputs are those just after t.
-void restart(Cvode& cv, Equations& eq, SimulationResult& r, double t) {
-  add_statistics(cv, r);
-  eq.start_segment(t);
-  if (CVodeReInit(cv.mem, t, cv.x) != CV_SUCCESS)
-    throw SimulationError("simulate: cannot restart at t = " + short_number(t) + " s (internal error)", t);
-  ++r.restarts;
-}
+// A time integrator as the sampling loop drives it: one step at a time, restarts where an input
+// jumps, and the state between steps from its interpolant.
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  // One step towards tout, not past stop; the time reached. SimulationError when it fails.
+  virtual double step(double tout, double stop) = 0;
+  // After a jump of an input at t (the new segment's inputs are those just after t).
+  virtual void restart(double t, SimulationResult& r) = 0;
+  virtual const double* state() = 0;  // at the time reached
+  virtual void interpolate(double t, double* x) = 0;
+  [[noreturn]] virtual void too_much_work(double t) = 0;
+  virtual void add_statistics(SimulationResult& r) = 0;
+};
+
+// CVODE (BDF or Adams) in its one-step mode.
+class CvodeIntegrator : public Integrator {
+ public:
+  CvodeIntegrator(Equations& eq, const SimulationOptions& o, const VectorXd& x0)
+      : eq_(eq), cv_(x0.size(), o.method, eq.analytic_jacobian()) {
+    Eigen::Map<VectorXd>(N_VGetArrayPointer(cv_.x), x0.size()) = x0;
+    configure(cv_, eq, o, message_);
+    sample_ = N_VNew_Serial(x0.size(), cv_.context);
+    if (!sample_) throw Error("simulate: out of memory for the integrator");
+  }
+  ~CvodeIntegrator() override { N_VDestroy(sample_); }
+  CvodeIntegrator(const CvodeIntegrator&) = delete;
+  CvodeIntegrator& operator=(const CvodeIntegrator&) = delete;
+
+  double step(double tout, double stop) override {
+    if (CVodeSetStopTime(cv_.mem, stop) != CV_SUCCESS)
+      throw SimulationError("simulate: cannot stop at t = " + short_number(stop) + " s (internal error)", reached_);
+    double reached = reached_;
+    const int flag = CVode(cv_.mem, std::min(tout, stop), cv_.x, &reached, CV_ONE_STEP);
+    if (flag < 0 || !std::isfinite(reached)) integration_failed(flag < 0 ? flag : CV_BAD_T, cv_, eq_, message_, reached_);
+    return reached_ = reached;
+  }
+  void restart(double t, SimulationResult& r) override {
+    add_statistics(r);
+    eq_.start_segment(t);
+    if (CVodeReInit(cv_.mem, t, cv_.x) != CV_SUCCESS)
+      throw SimulationError("simulate: cannot restart at t = " + short_number(t) + " s (internal error)", t);
+  }
+  const double* state() override { return N_VGetArrayPointer(cv_.x); }
+  void interpolate(double t, double* x) override {
+    if (CVodeGetDky(cv_.mem, t, 0, sample_) != CV_SUCCESS)
+      throw SimulationError("simulate: cannot interpolate " + at_time(t) + " (internal error)", t);
+    std::copy_n(N_VGetArrayPointer(sample_), N_VGetLength_Serial(sample_), x);
+  }
+  [[noreturn]] void too_much_work(double t) override { integration_failed(CV_TOO_MUCH_WORK, cv_, eq_, message_, t); }
+  void add_statistics(SimulationResult& r) override {  // CVodeReInit sets CVODE's counters to 0
+    long v = 0;
+    CVodeGetNumSteps(cv_.mem, &v), r.steps += v;
+    CVodeGetNumRhsEvals(cv_.mem, &v), r.rhs_evaluations += v;
+    if (cv_.solver) {
+      CVodeGetNumJacEvals(cv_.mem, &v), r.jacobian_evaluations += v;
+      CVodeGetNumLinRhsEvals(cv_.mem, &v), r.rhs_evaluations += v;  // difference-quotient Jacobians
+    }
+    CVodeGetNumErrTestFails(cv_.mem, &v), r.error_test_failures += v;
+    CVodeGetNumNonlinSolvConvFails(cv_.mem, &v), r.nonlinear_failures += v;
+  }
+
+ private:
+  Equations& eq_;
+  Cvode cv_;
+  std::string message_;
+  N_Vector sample_ = nullptr;
+  double reached_ = 0;
+};
+
+// Radau IIA (radau.hpp) on the implicit form.
+class RadauIntegrator : public Integrator {
+ public:
+  RadauIntegrator(Equations& eq, const SimulationOptions& o, const VectorXd& x0)
+      : eq_(eq), radau_(eq, eq.size(), o.rtol, absolute_tolerances(eq.kernels(), o)) {
+    start(0, x0);
+  }
+  double step(double, double stop) override {
+    const auto status = radau_.step(stop);
+    if (status == detail::Radau::Status::ok) return radau_.time();
+    const double h = radau_.step_size();
+    double t = radau_.time();
+    std::string why = "the integrator cannot advance (step size " + short_number(h) +
+                      " s): its error test or Newton iteration keeps failing (the motion is too fast there, or the "
+                      "forces or parameters are far out of range?)";
+    if (eq_.failure != Equations::Failure::none && std::isfinite(eq_.failed_time)) {
+      t = eq_.failed_time;
+      why = eq_.reason();
+    }
+    throw SimulationError("simulate: the integration stopped " + at_time(t) + ": " + why, t);
+  }
+  void restart(double t, SimulationResult&) override {
+    eq_.start_segment(t);
+    start(t, radau_.state());
+  }
+  const double* state() override { return radau_.state().data(); }
+  void interpolate(double t, double* x) override { radau_.interpolate(t, x); }
+  [[noreturn]] void too_much_work(double t) override {
+    throw SimulationError("simulate: the integration stopped " + at_time(t) + ": more than " +
+                              std::to_string(kMaxStepsPerSample) +
+                              " internal steps between two samples (the tolerance cannot be met at a reasonable "
+                              "cost, or the motion is too fast for the output step)",
+                          t);
+  }
+  void add_statistics(SimulationResult& r) override {
+    const detail::RadauStatistics& s = radau_.statistics();
+    r.steps += s.steps;
+    r.rhs_evaluations += s.evaluations;
+    r.jacobian_evaluations += s.jacobians;
+    r.error_test_failures += s.rejected;
+    r.nonlinear_failures += s.newton_failures;
+  }
+
+ private:
+  void start(double t, const VectorXd& x) {
+    if (!radau_.start(t, x))
+      throw SimulationError("simulate: the integration cannot start " + at_time(t) + ": " + eq_.reason(), t);
+  }
+  Equations& eq_;
+  detail::Radau radau_;
+};
 
 // The integrator's steps, one at a time (each accepted step moves the closed loops' anchor), up
 // to the stops and past the samples.
 class Stepper {
  public:
-  Stepper(Cvode& cv, Equations& eq, SimulationResult& r, const SimulationOptions& o, const std::string& message)
-      : cv_(cv), eq_(eq), r_(r), o_(o), message_(message), stops_(stop_times(o)), next_(stops_.begin()) {}
+  Stepper(Integrator& in, Equations& eq, SimulationResult& r, const SimulationOptions& o)
+      : in_(in), eq_(eq), r_(r), o_(o), stops_(stop_times(o)), next_(stops_.begin()) {}
 
   // The sample time for `t`: a sample within rounding of the next stop is taken at the stop
   // (after a restart the integrator cannot start a step of a few ulps).
@@ -567,22 +695,17 @@ class Stepper {
     return t;
   }
   // Steps until the integrator reaches tout or passes it; true when it stands at tout (the state
-  // is cv.x), false when past it (interpolate). A restart at a stop waits until the samples
-  // before it are taken from the old history.
+  // is in.state()), false when past it (interpolate). A restart at a stop waits until the
+  // samples before it are taken from the old history.
   bool step_to(double tout) {
     long steps = 0;
     while (t_ < tout) {
       pass_stops();
       const double stop = next_ != stops_.end() ? next_->t : o_.duration;
-      if (CVodeSetStopTime(cv_.mem, stop) != CV_SUCCESS)
-        throw SimulationError("simulate: cannot stop at t = " + short_number(stop) + " s (internal error)", t_);
-      if (++steps > kMaxStepsPerSample) integration_failed(CV_TOO_MUCH_WORK, cv_, eq_, message_, t_);
-      double reached = t_;
+      if (++steps > kMaxStepsPerSample) in_.too_much_work(t_);
       eq_.failure = Equations::Failure::none;
-      const int flag = CVode(cv_.mem, std::min(tout, stop), cv_.x, &reached, CV_ONE_STEP);
-      if (flag < 0 || !std::isfinite(reached)) integration_failed(flag < 0 ? flag : CV_BAD_T, cv_, eq_, message_, t_);
-      t_ = reached;
-      if (eq_.follows_loops()) eq_.advance(N_VGetArrayPointer(cv_.x));
+      t_ = in_.step(tout, stop);
+      if (eq_.follows_loops()) eq_.advance(in_.state());
     }
     return t_ == tout;
   }
@@ -590,13 +713,15 @@ class Stepper {
  private:
   void pass_stops() {
     for (; next_ != stops_.end() && t_ >= next_->t; ++next_)
-      if (next_->restart) restart(cv_, eq_, r_, next_->t);
+      if (next_->restart) {
+        in_.restart(next_->t, r_);
+        ++r_.restarts;
+      }
   }
-  Cvode& cv_;
+  Integrator& in_;
   Equations& eq_;
   SimulationResult& r_;
   const SimulationOptions& o_;
-  const std::string& message_;
   const std::vector<Stop> stops_;
   std::vector<Stop>::const_iterator next_;
   double t_ = 0;
@@ -624,39 +749,33 @@ SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op,
   if (eq.follows_loops() && !eq.close_initial(op.y0, y))
     throw SimulationError("simulate: the kinematic loops cannot be closed at the initial state (from the operating "
                           "point's configuration by continuation)", 0.0);
-  Cvode cv(2 * n, o.method, eq.analytic_jacobian());
-  std::string message;
-  double* x = N_VGetArrayPointer(cv.x);
-  Eigen::Map<VectorXd>(x, n) = y;
-  Eigen::Map<VectorXd>(x + n, n) = yd;
+  VectorXd x0(2 * n);
+  x0 << y, yd;
   if (!eq.evaluate(0.0, y.data(), yd.data()))
     throw SimulationError("simulate: the initial state fails " + at_time(0) + ": " + eq.reason(), 0.0);
-  configure(cv, eq, o, message);
+  std::unique_ptr<Integrator> in;
+  if (o.method == IntegrationMethod::radau)
+    in = std::make_unique<RadauIntegrator>(eq, o, x0);
+  else
+    in = std::make_unique<CvodeIntegrator>(eq, o, x0);
 
   const Index samples = sample_count(o);
   SimulationResult r = allocated(k, samples);
   r.analytic_jacobian = eq.analytic_jacobian();
-  record(r, 0, 0.0, x, eq);
-  Stepper stepper(cv, eq, r, o, message);
+  record(r, 0, 0.0, x0.data(), eq);
+  Stepper stepper(*in, eq, r, o);
   VectorXd sample(2 * n);
-  N_Vector sample_vector = N_VMake_Serial(2 * n, sample.data(), cv.context);
-  if (!sample_vector) throw Error("simulate: out of memory for the integrator");
-  struct Release {
-    N_Vector v;
-    ~Release() { N_VDestroy(v); }
-  } release{sample_vector};
   for (Index j = 1; j < samples; ++j) {
     const double tout = stepper.sample_time(j == samples - 1 ? o.duration : static_cast<double>(j) * o.step);
     if (stepper.step_to(tout)) {
-      record(r, j, tout, x, eq);
-    } else {  // the last step went past the sample: CVODE's interpolant there
-      if (CVodeGetDky(cv.mem, tout, 0, sample_vector) != CV_SUCCESS)
-        throw SimulationError("simulate: cannot interpolate " + at_time(tout) + " (internal error)", tout);
+      record(r, j, tout, in->state(), eq);
+    } else {  // the last step went past the sample: the integrator's interpolant there
+      in->interpolate(tout, sample.data());
       record(r, j, tout, sample.data(), eq);
     }
     if (o.progress) o.progress(tout);
   }
-  add_statistics(cv, r);
+  in->add_statistics(r);
   return r;
 }
 

@@ -78,7 +78,9 @@ class InputSignal {
   std::vector<double> t_, v_, breakpoints_;
 };
 
-enum class IntegrationMethod { bdf, adams };
+/// bdf and adams: SUNDIALS CVODE; radau: Radau IIA of order 5 (radau.hpp in the runtime's
+/// sources; Hairer and Wanner's RADAU5 on the implicit form M(y) ÿ + k − q = 0).
+enum class IntegrationMethod { bdf, adams, radau };
 
 struct SimulationOptions {
   IntegrationMethod method = IntegrationMethod::bdf;

@@ -1,0 +1,371 @@
+// Radau IIA of order 5 on M(y) ÿ + r(y, ẏ, t) = 0 (radau.hpp).
+#include "radau.hpp"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace mbsgen::detail {
+
+namespace {
+
+using Eigen::Index;
+using Eigen::Matrix3d;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+using complex = std::complex<double>;
+
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+constexpr int kNewtonIterations = 7;  // RADAU5's NIT
+constexpr double kKeepJacobian = 1e-3;  // RADAU5's THET: a Newton rate below it keeps the Jacobian
+constexpr double kSafety = 0.9;
+constexpr double kMaxGrowth = 10, kMinShrink = 0.2;  // per step
+
+const double kSqrt6 = std::sqrt(6.0);
+// The nodes, and the error estimate's weights (Hairer and Wanner IV.8, (8.20)).
+const double kC[3] = {(4 - kSqrt6) / 10, (4 + kSqrt6) / 10, 1};
+const double kE[3] = {(-13 - 7 * kSqrt6) / 3, (-13 + 7 * kSqrt6) / 3, -1.0 / 3};
+
+// The Butcher matrix A; its inverse (for the stage derivatives Ż = h⁻¹ (A⁻¹ ⊗ I) Z) and
+// T⁻¹A⁻¹T = [μ_r, 0, 0; 0, α, β; 0, −β, α], μ_c = α − iβ, with RADAU5's T.
+Matrix3d butcher() {
+  Matrix3d A;
+  A << (88 - 7 * kSqrt6) / 360, (296 - 169 * kSqrt6) / 1800, (-2 + 3 * kSqrt6) / 225,  //
+      (296 + 169 * kSqrt6) / 1800, (88 + 7 * kSqrt6) / 360, (-2 - 3 * kSqrt6) / 225,   //
+      (16 - kSqrt6) / 36, (16 + kSqrt6) / 36, 1.0 / 9;
+  return A;
+}
+const Matrix3d kAinv = butcher().inverse();
+const double kMuReal = 3 + std::cbrt(9.0) - std::cbrt(3.0);
+const complex kMuComplex(3 + 0.5 * (std::cbrt(3.0) - std::cbrt(9.0)), -0.5 * (std::pow(3.0, 5.0 / 6) + std::pow(3.0, 7.0 / 6)));
+Matrix3d transformation() {
+  Matrix3d T;
+  T << 0.09443876248897524, -0.14125529502095421, 0.03002919410514742,  //
+      0.25021312296533332, 0.20412935229379994, -0.38294211275726192,    //
+      1, 1, 0;
+  return T;
+}
+const Matrix3d kT = transformation();
+const Matrix3d kTinv = kT.inverse();
+// The collocation polynomial: x(t_old + s h) = x_old + (Z P) (s, s², s³)ᵀ.
+Matrix3d dense_output() {
+  Matrix3d P;
+  P << 13.0 / 3 + 7 * kSqrt6 / 3, -23.0 / 3 - 22 * kSqrt6 / 3, 10.0 / 3 + 5 * kSqrt6,  //
+      13.0 / 3 - 7 * kSqrt6 / 3, -23.0 / 3 + 22 * kSqrt6 / 3, 10.0 / 3 - 5 * kSqrt6,   //
+      1.0 / 3, -8.0 / 3, 10.0 / 3;
+  return P;
+}
+const Matrix3d kP = dense_output();
+
+// The step-size factor of the predictive controller (Gustafsson), from this step's error and
+// the last accepted one's (none: h_old = 0).
+double predicted_factor(double h, double h_old, double error, double error_old) {
+  double multiplier = 1;
+  if (h_old > 0 && error > 0 && error_old > 0) multiplier = h / h_old * std::pow(error_old / error, 0.25);
+  return error > 0 ? std::min(1.0, multiplier) * std::pow(error, -0.25) : kMaxGrowth;
+}
+
+}  // namespace
+
+Radau::Radau(SecondOrderSystem& system, Index n, double rtol, const VectorXd& atol)
+    : system_(system), n_(n), rtol_(rtol), atol_(atol),
+      newton_tol_(std::max(10 * kEpsilon / rtol, std::min(0.03, std::sqrt(rtol)))), x_(2 * n), x_old_(2 * n),
+      f0_(2 * n), scale_(2 * n), Z_(2 * n, 3), W_(2 * n, 3), Q_(2 * n, 3), MJ_(n, n), Ky_(n, n), Kv_(n, n),
+      equilibrate_(n), lu_real_(n), lu_complex_(n), G_(2 * n, 3), dW_(2 * n, 3), stage_(2 * n, 3), R_(n, n),
+      Rc_(n, n), x_new_(2 * n), b_(2 * n), e_(2 * n), f_(2 * n), ze_(2 * n), a_(n), work_re_(n), work_im_(n),
+      bc_(n), yc_(n) {}
+
+// ẋ = f(t, x) = (v, ÿ(t, y, v)).
+bool Radau::derivative(double t, const VectorXd& x, VectorXd& f) {
+  ++stats_.evaluations;
+  if (!system_.accelerations(t, x.data(), x.data() + n_, a_)) return false;
+  f.head(n_) = x.tail(n_);
+  f.tail(n_) = a_;
+  return f.allFinite();
+}
+
+double Radau::norm(const VectorXd& e, const VectorXd& scale) const {
+  return std::sqrt((e.array() / scale.array()).square().mean());
+}
+
+bool Radau::start(double t, const VectorXd& x) {
+  t_ = t;
+  x_ = x;
+  dense_ = false;
+  factored_ = false;
+  faccon_ = 1;
+  h_old_ = error_old_ = 0;
+  if (!derivative(t, x_, f0_) || !evaluate_jacobian(t, x_)) return false;
+  // The first step (Hairer, Nørsett and Wanner I, II.4, as SciPy's select_initial_step for an
+  // error estimate of order 3): from the sizes of x, ẋ and ẍ in the tolerances' units.
+  scale_ = atol_.array() + rtol_ * x_.array().abs();
+  const double d0 = norm(x_, scale_), d1 = norm(f0_, scale_);
+  const double h0 = d0 < 1e-5 || d1 < 1e-5 ? 1e-6 : 0.01 * d0 / d1;
+  b_ = x_ + h0 * f0_;
+  if (!derivative(t + h0, b_, f_)) return false;
+  const double d2 = norm(f_ - f0_, scale_) / h0;
+  const double h1 = d1 <= 1e-15 && d2 <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / std::max(d1, d2), 0.25);
+  h_ = std::min(100 * h0, h1);
+  return std::isfinite(h_) && h_ > 0;
+}
+
+// M, K_y, K_v at (t, x): the kernels', or difference quotients of the accelerations
+// (K_y = −M ∂ÿ/∂y, K_v = −M ∂ÿ/∂v), steps √ε · max(|x_j|, atol_j / rtol).
+bool Radau::evaluate_jacobian(double t, const VectorXd& x) {
+  ++stats_.jacobians;
+  current_jacobian_ = true;
+  factored_ = false;
+  if (system_.has_jacobian()) {
+    ++stats_.evaluations;
+    if (!system_.jacobian(t, x.data(), x.data() + n_, MJ_, Ky_, Kv_)) return false;
+  } else {
+    VectorXd xs = x, a0(n_);
+    ++stats_.evaluations;
+    if (!system_.jacobian_mass(t, x.data(), x.data() + n_, MJ_, a0)) return false;
+    for (Index j = 0; j < 2 * n_; ++j) {
+      const double delta = std::sqrt(kEpsilon) * std::max(std::abs(x[j]), atol_[j] / rtol_);
+      xs[j] = x[j] + delta;
+      ++stats_.evaluations;
+      if (!system_.accelerations(t, xs.data(), xs.data() + n_, a_)) return false;
+      (j < n_ ? Ky_.col(j) : Kv_.col(j - n_)).noalias() = -(MJ_ * (a_ - a0)) / (xs[j] - x[j]);
+      xs[j] = x[j];
+    }
+  }
+  if (!(MJ_.allFinite() && Ky_.allFinite() && Kv_.allFinite())) return false;
+  for (Index i = 0; i < n_; ++i) {
+    const double d = std::abs(MJ_(i, i));
+    equilibrate_[i] = d > 0 && std::isfinite(d) ? 1 / std::sqrt(d) : 1.0;
+  }
+  return true;
+}
+
+// The LUs of the Schur complements σ²M + σK_v + K_y for σ = μ_r/h and μ_c/h, equilibrated as
+// M is; false when one is singular to working precision.
+bool Radau::factor(double h) {
+  ++stats_.factorizations;
+  sigma_real_ = kMuReal / h;
+  sigma_complex_ = kMuComplex / h;
+  const auto S = equilibrate_.asDiagonal();
+  R_.noalias() = sigma_real_ * sigma_real_ * MJ_ + sigma_real_ * Kv_ + Ky_;
+  R_ = S * R_ * S;
+  Rc_ = (sigma_complex_ * sigma_complex_) * MJ_.cast<complex>() + sigma_complex_ * Kv_.cast<complex>() +
+        Ky_.cast<complex>();
+  Rc_ = S * Rc_ * S;
+  lu_real_.compute(R_);
+  lu_complex_.compute(Rc_);
+  auto pivots_ok = [this](const auto& lu) {
+    const auto d = lu.matrixLU().diagonal().cwiseAbs();
+    const double largest = d.maxCoeff(), smallest = d.minCoeff();
+    return std::isfinite(largest) && smallest > static_cast<double>(n_) * kEpsilon * largest;
+  };
+  factored_ = pivots_ok(lu_real_) && pivots_ok(lu_complex_);
+  h_factored_ = h;
+  return factored_;
+}
+
+// (σI − J)(Δy, Δv) = (b_y, b_v), J = [0, I; −M⁻¹K_y, −M⁻¹K_v], for the real σ: its second row
+// times M is K_y Δy + (σM + K_v) Δv = M b_v, and through Δv, (σ²M + σK_v + K_y) Δv =
+// σ M b_v − K_y b_y and Δy = (b_y + Δv)/σ (which divides Δv's rounding by σ; through Δy,
+// Δv = σΔy − b_y would multiply Δy's by σ).
+void Radau::solve_real(const double* b, double* out) {
+  Eigen::Map<const VectorXd> by(b, n_), bv(b + n_, n_);
+  Eigen::Map<VectorXd> dy(out, n_), dv(out + n_, n_);
+  VectorXd& rhs = work_re_;
+  rhs.noalias() = sigma_real_ * (MJ_ * bv);
+  rhs.noalias() -= Ky_ * by;
+  rhs.array() *= equilibrate_.array();
+  dv = lu_real_.solve(rhs);
+  dv.array() *= equilibrate_.array();
+  dy = (by + dv) / sigma_real_;
+}
+
+// The same for the complex σ, on b_re + i b_im.
+void Radau::solve_complex(const double* b_re, const double* b_im, double* out_re, double* out_im) {
+  Eigen::Map<const VectorXd> yr(b_re, n_), vr(b_re + n_, n_), yi(b_im, n_), vi(b_im + n_, n_);
+  const double sr = sigma_complex_.real(), si = sigma_complex_.imag();
+  work_re_.noalias() = MJ_ * vr;
+  work_im_.noalias() = MJ_ * vi;
+  bc_.real() = sr * work_re_ - si * work_im_;
+  bc_.imag() = sr * work_im_ + si * work_re_;
+  work_re_.noalias() = Ky_ * yr;
+  work_im_.noalias() = Ky_ * yi;
+  bc_.real() -= work_re_;
+  bc_.imag() -= work_im_;
+  bc_.array() *= equilibrate_.array().cast<complex>();
+  yc_ = lu_complex_.solve(bc_);
+  yc_.array() *= equilibrate_.array().cast<complex>();
+  Eigen::Map<VectorXd>(out_re + n_, n_) = yc_.real();
+  Eigen::Map<VectorXd>(out_im + n_, n_) = yc_.imag();
+  bc_.real() = yr + yc_.real();
+  bc_.imag() = yi + yc_.imag();
+  bc_ /= sigma_complex_;
+  Eigen::Map<VectorXd>(out_re, n_) = bc_.real();
+  Eigen::Map<VectorXd>(out_im, n_) = bc_.imag();
+}
+
+// The stage residuals G_i = Ż_i − f(X_i), Ż = h⁻¹ Z A⁻ᵀ, of the stage increments Z_.
+//
+// The explicit form, ÿ = −M(Y_i)⁻¹ r at each stage, rather than M(Y_i) Ż_i + r: the Newton
+// matrix holds one M for all three stages, and where M varies along the step (by 1e-5 of itself
+// in the middle ear at 1 Pa), the implicit form's residual no longer matches it. A rotation
+// that barely moves, held to its own small tolerance, then made Newton's iteration converge
+// slowly (two to three iterations more per step, and a Jacobian at most steps).
+bool Radau::residuals(double h) {
+  G_.noalias() = Z_ * (kAinv.transpose() / h);  // Ż
+  for (int i = 0; i < 3; ++i) {
+    b_ = x_ + Z_.col(i);
+    if (!derivative(t_ + kC[i] * h, b_, f_)) return false;
+    G_.col(i) -= f_;
+  }
+  return true;
+}
+
+// The simplified Newton iteration on the stage increments Z_ (from its initial value), in the
+// coordinates W = Z T⁻ᵀ (RADAU5's convergence test: the rate θ of the last iterations, and a
+// first iteration accepted when the last step's rate says it has converged). False when it
+// diverges, is too slow, or an evaluation fails.
+bool Radau::newton(double h, int& iterations, double& theta) {
+  W_.noalias() = Z_ * kTinv.transpose();
+  double norm_old = 0, ratio_old = 0;
+  theta = kKeepJacobian;
+  faccon_ = std::pow(std::max(faccon_, kEpsilon), 0.8);
+  for (int k = 1; k <= kNewtonIterations; ++k) {
+    iterations = k;
+    if (!residuals(h)) return false;
+    stage_.noalias() = -G_ * kTinv.transpose();
+    solve_real(stage_.col(0).data(), dW_.col(0).data());
+    solve_complex(stage_.col(1).data(), stage_.col(2).data(), dW_.col(1).data(), dW_.col(2).data());
+    double sum = 0;
+    for (int i = 0; i < 3; ++i) sum += (dW_.col(i).array() / scale_.array()).square().sum();
+    const double dW_norm = std::sqrt(sum / static_cast<double>(3 * 2 * n_));
+    if (!std::isfinite(dW_norm)) return false;
+    if (k > 1) {
+      const double ratio = dW_norm / norm_old;
+      theta = k == 2 ? ratio : std::sqrt(ratio * ratio_old);
+      ratio_old = ratio;
+      if (theta >= 0.99) return false;
+      faccon_ = theta / (1 - theta);
+      if (faccon_ * dW_norm * std::pow(theta, kNewtonIterations - 1 - k) >= newton_tol_) return false;  // too slow
+    }
+    norm_old = std::max(dW_norm, kEpsilon);
+    W_ += dW_;
+    Z_.noalias() = W_ * kT.transpose();
+    if (faccon_ * dW_norm <= newton_tol_) return true;
+  }
+  return false;
+}
+
+// The embedded error estimate, filtered by the real system: e = (σ_r I − J)⁻¹ (f(x₀) + Z E/h),
+// and again from f(x₀ + e) where the first one fails after a rejected step (Hairer and Wanner
+// IV.8, (8.19)–(8.20)). Its RMS norm in the tolerances.
+double Radau::error_norm(double h, const VectorXd& x_new, bool again) {
+  ze_.noalias() = Z_ * (Eigen::Vector3d(kE[0], kE[1], kE[2]) / h);
+  b_ = f0_ + ze_;
+  solve_real(b_.data(), e_.data());
+  f_ = atol_.array() + rtol_ * x_.array().abs().max(x_new.array().abs());  // the scale
+  double error = norm(e_, f_);
+  if (again && error > 1) {
+    b_ = x_ + e_;
+    if (!derivative(t_, b_, e_)) return std::numeric_limits<double>::infinity();
+    b_ = e_ + ze_;
+    solve_real(b_.data(), e_.data());
+    error = norm(e_, f_);
+  }
+  return error;
+}
+// The stage increments of a step of size h from (t_, x_), by Newton's method from the last
+// step's polynomial (or zero), with the Jacobian evaluated again where an old one fails.
+bool Radau::try_step(double h, int& iterations, double& theta) {
+  for (;;) {
+    if (dense_) {
+      for (int i = 0; i < 3; ++i) {
+        const double s = (t_ + kC[i] * h - t_old_) / h_last_;
+        Z_.col(i) = x_old_ - x_;
+        Z_.col(i).noalias() += Q_ * Eigen::Vector3d(s, s * s, s * s * s);
+      }
+    } else {
+      Z_.setZero();
+    }
+    if ((factored_ && h == h_factored_) || factor(h))
+      if (newton(h, iterations, theta)) return true;
+    if (current_jacobian_) return false;
+    if (!evaluate_jacobian(t_, x_)) {
+      jacobian_failed_ = true;
+      return false;
+    }
+  }
+}
+
+Radau::Status Radau::step(double t_stop) {
+  bool rejected = false;
+  for (;;) {
+    const double min_step = 10 * (std::nextafter(t_, std::numeric_limits<double>::infinity()) - t_);
+    if (!(h_ >= min_step)) return Status::step_too_small;
+    const bool last = t_stop - t_ <= 1.1 * h_;
+    const double h = last ? t_stop - t_ : h_;
+    const double t_new = last ? t_stop : t_ + h;
+    scale_ = atol_.array() + rtol_ * x_.array().abs();
+    int iterations = 0;
+    double theta = 0;
+    if (!try_step(h, iterations, theta)) {
+      if (jacobian_failed_) return Status::failed;
+      ++stats_.newton_failures;
+      h_ = 0.5 * h;
+      rejected = true;
+      continue;
+    }
+    x_new_ = x_ + Z_.col(2);
+    const double error = error_norm(h, x_new_, rejected || stats_.steps == 0);
+    const double safety = kSafety * (2 * kNewtonIterations + 1) / (2 * kNewtonIterations + iterations);
+    if (!(error <= 1)) {
+      ++stats_.rejected;
+      rejected = true;
+      h_ = h * std::max(kMinShrink, safety * predicted_factor(h, h_old_, error, error_old_));
+      continue;
+    }
+    if (!derivative(t_new, x_new_, b_)) {  // the next step's f(x₀): a step too far
+      ++stats_.rejected;
+      rejected = true;
+      h_ = 0.5 * h;
+      continue;
+    }
+    return accept(t_new, h, error, safety, iterations, theta) ? Status::ok : Status::failed;
+  }
+}
+
+// Moves to the step's end (its f in b_), with the next step's size, and
+// the Jacobian there when the Newton iteration converged slowly.
+bool Radau::accept(double t_new, double h, double error, double safety, int iterations, double theta) {
+  ++stats_.steps;
+  x_old_.swap(x_);
+  x_.swap(x_new_);
+  t_old_ = t_;
+  t_ = t_new;
+  h_last_ = h;
+  Q_.noalias() = Z_ * kP;
+  dense_ = true;
+  f0_ = b_;
+  double factor = std::min(kMaxGrowth, safety * predicted_factor(h, h_old_, error, error_old_));
+  h_old_ = h;
+  error_old_ = error;
+  const bool recompute = iterations > 2 && theta > kKeepJacobian;
+  if (!recompute && factor >= 1 && factor <= 1.2) factor = 1;  // the same h: the same LU
+  h_ = h * factor;
+  if (!recompute) {
+    current_jacobian_ = false;
+    return true;
+  }
+  jacobian_failed_ = !evaluate_jacobian(t_, x_);
+  return !jacobian_failed_;
+}
+
+void Radau::interpolate(double t, double* x) const {
+  const double s = (t - t_old_) / h_last_;
+  Eigen::Map<VectorXd> out(x, 2 * n_);
+  out = x_old_;
+  out.noalias() += Q_ * Eigen::Vector3d(s, s * s, s * s * s);
+}
+
+}  // namespace mbsgen::detail
