@@ -69,14 +69,16 @@ void write(const std::string& path, const mbsgen::SimulationResult& r) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: simulation_timing OUT_DIR [REPEATS]\n");
+    std::fprintf(stderr, "usage: simulation_timing OUT_DIR [REPEATS [PROBLEM]]\n");
     return 2;
   }
   const std::string dir = argv[1];
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 5;
+  const std::string only = argc > 3 ? argv[3] : "";  // one problem (a quick look while tuning)
   std::ofstream summary(dir + "/ours_timing.csv");
   summary << "problem,method,rtol,seconds,steps\n";
   for (const Problem& p : problems()) {
+    if (!only.empty() && p.name != only) continue;
     mbsgen::GeneratedModel model(*p.k);
     const mbsgen::OperatingPoint op = model.operating_point();
     const bool stiff = p.name == "middle_ear";
@@ -99,6 +101,7 @@ int main(int argc, char** argv) {
       for (int k = 8; k <= (stiff ? 20 : 24); ++k) rtols.push_back(std::pow(10.0, -0.5 * k));
       for (double rtol : rtols) {
         mbsgen::SimulationOptions o = p.base;
+        o.outputs = false;  // the states only, as SciPy's runs give (the middle ear's F_cochlea needs ÿ at each sample)
         o.method = method;
         o.rtol = rtol;
         o.atol = rtol * p.atol_scale;

@@ -62,6 +62,10 @@ std::vector<double> zero_crossings(const SimulationResult& r, Eigen::Index i) {
   return times;
 }
 
+const char* method_name(mbsgen::IntegrationMethod m) {
+  return m == mbsgen::IntegrationMethod::bdf ? "bdf" : m == mbsgen::IntegrationMethod::radau ? "radau" : "adams";
+}
+
 // The period of the simple pendulum at amplitude θ0: T = 4 √(l/g) K(sin(θ0/2)) (the complete
 // elliptic integral of the first kind of modulus k; e.g. Landau & Lifshitz, Mechanics, §11,
 // problem 1), against the zero crossings of φ over ten periods (Adams, rtol 1e-12): to 1e-9.
@@ -125,14 +129,14 @@ TEST(Simulation, DoublePendulumConservesEnergyOver100Periods) {
 }
 
 // The drift is the integrator's error, so it falls with the tolerance: by at least 10 from rtol
-// 1e-9 to 1e-11 for both methods, also in chaotic motion (from 1.5 and 2 rad); BDF on the
+// 1e-9 to 1e-11 for every method, also in chaotic motion (from 1.5 and 2 rad); BDF on the
 // Jacobian kernel and on difference quotients alike.
 TEST(Simulation, DoublePendulumEnergyDriftFallsWithTheTolerance) {
   GeneratedModel model(double_pendulum::kernels());
-  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::bdf})
+  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::bdf, mbsgen::IntegrationMethod::radau})
     for (const auto& [p1, p2] : std::vector<std::pair<double, double>>{{0.3, -0.2}, {1.5, 2.0}}) {
       const double coarse = energy_drift(model, method, p1, p2, 1e-9), fine = energy_drift(model, method, p1, p2, 1e-11);
-      EXPECT_LT(fine, coarse / 10) << (method == mbsgen::IntegrationMethod::bdf ? "bdf" : "adams") << " from " << p1
+      EXPECT_LT(fine, coarse / 10) << method_name(method) << " from " << p1
                                    << ", " << p2 << ": " << coarse << " at 1e-9, " << fine << " at 1e-11";
     }
 }
@@ -248,7 +252,8 @@ TEST(Simulation, LinearRotorStepResponseMatchesTheMatrixExponential) {
     bool quotients;
   };
   for (const Case c : {Case{mbsgen::IntegrationMethod::bdf, false}, Case{mbsgen::IntegrationMethod::bdf, true},
-                       Case{mbsgen::IntegrationMethod::adams, false}}) {
+                       Case{mbsgen::IntegrationMethod::adams, false}, Case{mbsgen::IntegrationMethod::radau, false},
+                       Case{mbsgen::IntegrationMethod::radau, true}}) {
     double error[2] = {};
     for (int tight = 0; tight < 2; ++tight) {
       SimulationOptions o;
@@ -256,12 +261,16 @@ TEST(Simulation, LinearRotorStepResponseMatchesTheMatrixExponential) {
       o.difference_quotients = c.quotients;
       o.duration = 5;
       o.step = 1e-3;
-      o.rtol = tight ? 1e-11 : 1e-9;
+      // Radau is 100 times as accurate at each tolerance: at 1e-9 it is within 7e-11 of itself at
+      // 1e-11, below the error of the eigendecomposition behind `exact` (3e-10 at t = 4 s), so
+      // it is compared at 1e-6 and 1e-8.
+      const bool radau = c.method == mbsgen::IntegrationMethod::radau;
+      o.rtol = tight ? (radau ? 1e-8 : 1e-11) : (radau ? 1e-6 : 1e-9);
       o.atol = o.rtol * 1e-7;  // the response is 5e-6 m and 1e-3 m/s
       o.inputs = {InputSignal::step(U, ts)};
       const SimulationResult r = run(model, o);
       EXPECT_EQ(r.restarts, 1);
-      EXPECT_EQ(r.analytic_jacobian, c.method == mbsgen::IntegrationMethod::bdf && !c.quotients);
+      EXPECT_EQ(r.analytic_jacobian, c.method != mbsgen::IntegrationMethod::adams && !c.quotients);
       double worst_y = 0, worst_v = 0, size_y = 0, size_v = 0;
       for (Eigen::Index k = 0; k < r.t.size(); ++k) {
         const Eigen::VectorXd x = exact(r.t[k]);
@@ -273,10 +282,10 @@ TEST(Simulation, LinearRotorStepResponseMatchesTheMatrixExponential) {
       }
       error[tight] = std::max(worst_y / size_y, worst_v / size_v);
     }
-    const std::string which = std::string(c.method == mbsgen::IntegrationMethod::bdf ? "bdf" : "adams") +
+    const std::string which = std::string(method_name(c.method)) +
                               (c.quotients ? " (difference quotients)" : "");
-    EXPECT_LT(error[1], 1e-7) << which << ": " << error[1] << " at rtol 1e-11";
-    EXPECT_LT(error[1], error[0] / 10) << which << ": " << error[0] << " at 1e-9, " << error[1] << " at 1e-11";
+    EXPECT_LT(error[1], 1e-7) << which << ": " << error[1] << " at the tighter rtol";
+    EXPECT_LT(error[1], error[0] / 10) << which << ": " << error[0] << " and " << error[1];
   }
 }
 
@@ -384,9 +393,11 @@ TEST(Simulation, InputSignals) {
 // steady state, fitted over the last `fit` of `periods` periods), divided by the frequency
 // response's A·G (FrequencyResponse, the runtime's method), minus 1.
 std::complex<double> sine_against_frf(const GeneratedModel& model, Eigen::Index input, Eigen::Index output, double hz,
-                                      double A, int periods, int fit, double rtol) {
+                                      double A, int periods, int fit, double rtol,
+                                      mbsgen::IntegrationMethod method = mbsgen::IntegrationMethod::bdf) {
   const mbsgen::OperatingPoint op = model.operating_point();
   mbsgen::SineResponseOptions o;
+  o.method = method;
   o.periods = periods;
   o.fit_periods = fit;
   o.rtol = rtol;
@@ -458,7 +469,7 @@ TEST(Simulation, TableInputIsFollowedFromRest) {
     csv << "\xEF\xBB\xBFtime,F\r\n# a comment\r\n0,0\r\n" << t1 << ",0\r\n" << t1 + w << "," << U << "\r\n"
         << t1 + 2 * w << ",0\r\n3,0\r\n";
   }
-  for (auto method : {mbsgen::IntegrationMethod::bdf, mbsgen::IntegrationMethod::adams}) {
+  for (auto method : {mbsgen::IntegrationMethod::bdf, mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::radau}) {
     SimulationOptions o;
     o.method = method;
     o.duration = 1.5;
@@ -475,7 +486,7 @@ TEST(Simulation, TableInputIsFollowedFromRest) {
       size = std::max(size, x.head(2).cwiseAbs().maxCoeff());
     }
     EXPECT_GT(size, 1e-9);
-    EXPECT_LT(worst, 1e-5 * size) << (method == mbsgen::IntegrationMethod::bdf ? "bdf" : "adams");
+    EXPECT_LT(worst, 1e-5 * size) << method_name(method);
   }
   std::remove(path.c_str());
 }
@@ -687,6 +698,105 @@ TEST(Simulation, FourBarCrankTurnsFully) {
 // be A cos(100 t). Bound: 1e-7 A, the integration error at rtol 1e-11 over 5 slow periods (the
 // nonlinearity's part is O(A²) = 1e-12 of A). The full model (difference-quotient Jacobians)
 // gives the same motion to the same bound.
+// Radau IIA (--method radau) against the closed forms the other methods meet: the pendulum's
+// period at large amplitude to 1e-9 (rtol 1e-12, as Adams above; the zero crossings come from
+// its collocation polynomials between samples of 1 ms).
+TEST(Simulation, RadauPendulumPeriodMatchesTheEllipticIntegral) {
+  GeneratedModel model(simple_pendulum::kernels());
+  const double l = 1.0, g = 9.81;
+  for (double theta0 : {1.0, 3.0}) {
+    const double T = 4 * std::sqrt(l / g) * std::comp_ellint_1(std::sin(theta0 / 2));
+    SimulationOptions o;
+    o.method = mbsgen::IntegrationMethod::radau;
+    o.duration = 10.2 * T;
+    o.step = 1e-3;
+    o.rtol = 1e-12;
+    o.atol = 1e-14;
+    o.initial = {{"phi", theta0}};
+    const SimulationResult r = run(model, o);
+    EXPECT_TRUE(r.analytic_jacobian);
+    const std::vector<double> c = zero_crossings(r, 0);
+    ASSERT_EQ(c.size(), 20u) << "theta0 " << theta0;
+    const double measured = 2 * (c.back() - c.front()) / static_cast<double>(c.size() - 1);
+    EXPECT_NEAR(measured / T, 1.0, 1e-9) << "theta0 " << theta0 << ": T " << T << " s, measured " << measured;
+  }
+}
+
+// The middle ear's steady state under a small tone against its frequency response (as
+// SmallSinesAgreeWithTheFrequencyResponse for BDF): within 1e-5 at 200 Pa, 1 kHz, and the
+// difference falls with the amplitude (it is the model's nonlinearity, not the integrator's).
+TEST(Simulation, RadauMiddleEarSineAgreesWithTheFrequencyResponse) {
+  GeneratedModel model(middle_ear::kernels());
+  const Eigen::Index input = model.input_index("P"), output = model.output_index("v_stapes");
+  const auto radau = mbsgen::IntegrationMethod::radau;
+  const double large = std::abs(sine_against_frf(model, input, output, 1000, 2000, 10, 5, 1e-9, radau));
+  const double small = std::abs(sine_against_frf(model, input, output, 1000, 200, 10, 5, 1e-9, radau));
+  EXPECT_LT(small, 1e-5) << large << " at 2000 Pa, " << small << " at 200 Pa";
+  EXPECT_LT(small, large / 6) << large << " at 2000 Pa, " << small << " at 200 Pa";
+}
+
+// A closed loop (the four-bar: difference-quotient Jacobians, as its kernels have no
+// dynamics_jacobian) keeps its small-oscillation period to 1e-6 and Φ below 1e-12.
+TEST(Simulation, RadauFourBarKeepsItsLoopClosed) {
+  GeneratedModel model(four_bar::kernels());
+  const mbsgen::OperatingPoint op = model.operating_point();
+  const double omega = std::sqrt(115.2470787951297394601), T = 2 * kPi / omega;
+  SimulationOptions o;
+  o.method = mbsgen::IntegrationMethod::radau;
+  o.duration = 10.2 * T;
+  o.step = T / 200;
+  o.rtol = 1e-12;
+  o.atol = 1e-16;
+  o.initial = {{"th1", op.y0[0] + 1e-4}};
+  SimulationResult r = run(model, o);
+  EXPECT_FALSE(r.analytic_jacobian);
+  EXPECT_GT(r.constraint_drift, 0.0);
+  EXPECT_LT(r.constraint_drift, 1e-12);
+  r.y.array() -= op.y0[0];
+  const std::vector<double> c = zero_crossings(r, 0);
+  ASSERT_EQ(c.size(), 20u);
+  const double measured = 2 * (c.back() - c.front()) / static_cast<double>(c.size() - 1);
+  EXPECT_NEAR(measured / T, 1.0, 1e-6) << "period " << measured << " s against " << T << " s";
+}
+
+// Radau's failures carry the time and the cause, as CVODE's do.
+TEST(Simulation, RadauFailuresAreReportedWithTheTime) {
+  {  // singular M at the spherical pendulum's pole (no Jacobian kernel: difference quotients)
+    GeneratedModel model(spherical_pendulum_conical::kernels());
+    SimulationOptions o;
+    o.method = mbsgen::IntegrationMethod::radau;
+    o.initial = {{"theta", 0.0}, {"phi_dot", 0.0}};
+    double t = -1;
+    const std::string what = failure_of(model, o, &t);
+    EXPECT_NE(what.find("the mass matrix is singular"), std::string::npos) << what;
+    EXPECT_EQ(t, 0.0) << what;
+  }
+  {  // gravity of 1e300 m/s²: no first step
+    GeneratedModel model(simple_pendulum::kernels());
+    model.set("g", 1e300);
+    SimulationOptions o;
+    o.method = mbsgen::IntegrationMethod::radau;
+    o.initial = {{"phi", 1.0}};
+    double t = -1;
+    const std::string what = failure_of(model, o, &t);
+    EXPECT_NE(what.find("cannot start at t = 0 s: no first step fits"), std::string::npos) << what;
+    EXPECT_EQ(t, 0.0) << what;
+  }
+  {  // more steps between two samples than allowed
+    GeneratedModel model(simple_pendulum::kernels());
+    model.set("g", 1e7);
+    SimulationOptions o;
+    o.method = mbsgen::IntegrationMethod::radau;
+    o.duration = 1000;
+    o.step = 1000;
+    o.initial = {{"phi", 1.0}};
+    double t = -1;
+    const std::string what = failure_of(model, o, &t);
+    EXPECT_NE(what.find("internal steps between two samples"), std::string::npos) << what;
+    EXPECT_GT(t, 0.0) << what;
+  }
+}
+
 TEST(Simulation, SceneKeepsWhatMotionNeeds) {
   GeneratedModel scene(rotor_disk_motion::kernels());
   EXPECT_STREQ(scene.kernels().scene, "motion");

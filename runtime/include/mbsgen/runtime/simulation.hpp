@@ -96,8 +96,11 @@ struct SimulationOptions {
   std::vector<std::pair<std::string, double>> initial;
   /// One signal per input, in the kernels' order, or empty for all inputs zero.
   std::vector<InputSignal> inputs;
-  /// BDF: difference-quotient Jacobians even when the kernels have `dynamics_jacobian`.
+  /// BDF and Radau: difference-quotient Jacobians even when the kernels have `dynamics_jacobian`.
   bool difference_quotients = false;
+  /// False: the outputs are not evaluated (SimulationResult::z has no rows). Outputs that depend
+  /// on ÿ cost one evaluation of the equations of motion per sample.
+  bool outputs = true;
   /// Called after each output sample with its time (a progress bar).
   std::function<void(double)> progress;
 };
@@ -106,7 +109,7 @@ struct SimulationResult {
   Eigen::VectorXd t;      ///< sample times, s
   Eigen::MatrixXd y, yd;  ///< n_coordinates × samples
   Eigen::MatrixXd u;      ///< n_inputs × samples
-  Eigen::MatrixXd z;      ///< n_outputs × samples (0 × samples when !simulates_outputs())
+  Eigen::MatrixXd z;      ///< n_outputs × samples (0 × samples when !simulates_outputs() or !options.outputs)
   bool analytic_jacobian = false;  ///< BDF's Newton matrices from `dynamics_jacobian`
   /// Closed loops: the largest |Φ| over the samples, in the constraints' units (metres for a
   /// pin). The kernels close the loops by Newton's method at every evaluation (coordinate
