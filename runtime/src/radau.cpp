@@ -21,6 +21,11 @@ constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 constexpr int kNewtonIterations = 7;  // RADAU5's NIT
 constexpr double kKeepJacobian = 1e-3;  // RADAU5's THET: a Newton rate below it keeps the Jacobian
 constexpr double kSafety = 0.9;
+// A Newton iteration on a fresh Jacobian that stops contracting with corrections below this (in
+// the error norm's units, where 1 is the tolerance) has reached the rounding in f: the middle ear
+// at rtol 1e-8, whose smallest motions' absolute tolerances (1e-17) are below its kernels'
+// rounding. Its iterate is kept (RADAU5 and SciPy halve the step instead, again and again).
+constexpr double kStalled = 0.1;
 constexpr double kMaxGrowth = 10, kMinShrink = 0.2;  // per step
 
 const double kSqrt6 = std::sqrt(6.0);
@@ -96,6 +101,7 @@ bool Radau::start(double t, const VectorXd& x) {
   dense_ = false;
   factored_ = false;
   faccon_ = 1;
+  fresh_theta_ = 0;
   jacobian_failed_ = false;
   h_old_ = error_old_ = 0;
   if (!derivative(t, x_, f0_) || !evaluate_jacobian(t, x_)) return false;
@@ -245,18 +251,21 @@ bool Radau::newton(double h, int& iterations, double& theta) {
     for (int i = 0; i < 3; ++i) sum += (dW_.col(i).array() / scale_.array()).square().sum();
     const double dW_norm = std::sqrt(sum / static_cast<double>(3 * 2 * n_));
     if (!std::isfinite(dW_norm)) return false;
+    bool stalled = false;
     if (k > 1) {
       const double ratio = dW_norm / norm_old;
       theta = k == 2 ? ratio : std::sqrt(ratio * ratio_old);
       ratio_old = ratio;
-      if (theta >= 0.99) return false;
-      faccon_ = theta / (1 - theta);
-      if (faccon_ * dW_norm * std::pow(theta, kNewtonIterations - 1 - k) >= newton_tol_) return false;  // too slow
+      const bool slow = theta >= 0.99 || (theta / (1 - theta)) * dW_norm *
+                                                 std::pow(theta, kNewtonIterations - 1 - k) >= newton_tol_;
+      stalled = slow && current_jacobian_ && dW_norm <= kStalled;  // at the rounding in f
+      if (slow && !stalled) return false;
+      if (!stalled) faccon_ = theta / (1 - theta);
     }
     norm_old = std::max(dW_norm, kEpsilon);
     W_ += dW_;
     Z_.noalias() = W_ * kT.transpose();
-    if (faccon_ * dW_norm <= newton_tol_) return true;
+    if (stalled || faccon_ * dW_norm <= newton_tol_) return true;
   }
   return false;
 }
@@ -354,7 +363,12 @@ bool Radau::accept(double t_new, double h, double error, double safety, int iter
   double factor = std::min(kMaxGrowth, safety * predicted_factor(h, h_old_, error, error_old_));
   h_old_ = h;
   error_old_ = error;
-  const bool recompute = iterations > 2 && theta > kKeepJacobian;
+  // A Jacobian again where the iteration converged slowly (RADAU5, SciPy), unless it converged
+  // as slowly with a fresh one: then the rate is that of the rounding in f (the middle ear at
+  // tight tolerances, whose smallest motions' tolerances are below its kernels' rounding), which
+  // no Jacobian improves; more than four times that rate is the Jacobian's again.
+  if (current_jacobian_ && iterations > 1) fresh_theta_ = theta;
+  const bool recompute = iterations > 2 && theta > std::max(kKeepJacobian, 4 * fresh_theta_);
   // The same h, and so the same LUs, unless the controller asks for 1.2 times it or more (as
   // SciPy's Radau; RADAU5 keeps it between 1 and 1.2 only): a smaller step than the controller's
   // is still accepted by the next error test, and the middle ear then factors half as often.

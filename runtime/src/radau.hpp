@@ -88,6 +88,7 @@ class Radau {
   bool current_jacobian_ = false;
   bool jacobian_failed_ = false;
   bool factored_ = false;
+  double fresh_theta_ = 0;   // θ of the last step's Newton iteration on a fresh Jacobian
   double faccon_ = 1;          // RADAU5's FACCON: θ/(1 − θ) of the last Newton iteration
   double h_factored_ = 0;
   Eigen::VectorXd x_, x_old_, f0_, scale_;  // f0_: ẋ at the step's start

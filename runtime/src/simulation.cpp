@@ -105,7 +105,7 @@ class Equations : public detail::SecondOrderSystem {
  public:
   Equations(const GeneratedModel& model, const SimulationOptions& o)
       : k_(model.kernels()), p_(model.parameters()), n_(k_.n_coordinates), options_(o),
-        M_(n_, n_), r_(n_), u_(k_.n_inputs), a_(n_), scale_(n_), scaled_(n_, n_), llt_(n_), lu_(n_) {}
+        M_(n_, n_), r_(n_), u_(k_.n_inputs), a_(n_), scale_(n_), scaled_r_(n_), scaled_(n_, n_), llt_(n_), lu_(n_) {}
 
   // Closed loops, followed through any range: the tree's coordinates at the last accepted step
   // (`anchor_`), from which every evaluation closes the loops again (assemble_from).
@@ -171,36 +171,48 @@ class Equations : public detail::SecondOrderSystem {
     if (signal_values) inputs_at(t); else inputs(t);
     if (!kernels(t, y, yd)) return false;
     if (!factor_mass()) return fail(t, Failure::singular_mass);
-    // ÿ = −S (S M S)⁻¹ S (k − q)
-    r_.array() *= scale_.array();
-    if (cholesky_)
+    if (cholesky_) {  // ÿ = −M⁻¹ (k − q)
       a_.noalias() = llt_.solve(r_);
-    else
-      a_.noalias() = lu_.solve(r_);
-    a_.array() *= -scale_.array();
+      a_ = -a_;
+    } else {  // ÿ = −S (S M S)⁻¹ S (k − q)
+      scaled_r_ = r_.cwiseProduct(scale_);
+      a_.noalias() = lu_.solve(scaled_r_);
+      a_.array() *= -scale_.array();
+    }
     if (!a_.allFinite()) return fail(t, Failure::non_finite);
     return true;
   }
-  // The factors of the equilibrated S M S, S = diag(|M_ii|)^(-1/2) (its pivots do not depend on
-  // the units: kg against kg m²). A mass matrix is symmetric positive definite: Cholesky's
-  // factors first (Eigen's are unblocked below 32 coordinates, and a third of the LU's work:
-  // half the time of an evaluation of the middle ear was its blocked LU), the LU's where they
-  // fail. False when M is singular to working precision: the ratio of the pivots (L_ii² of
-  // Cholesky's) bounds the reciprocal condition number from above (Eigen's rcond() estimate is 1
-  // for an exactly singular matrix), and where it is below 1e-8 the condition estimate decides
-  // (a few solves more, so not at every evaluation of a well-conditioned M).
+  // The factors of M, judged by those of the equilibrated S M S, S = diag(|M_ii|)^(-1/2) (whose
+  // pivots do not depend on the units: kg against kg m²). A mass matrix is symmetric positive
+  // definite: Cholesky's factors first, of M itself, since S M S = (S L)(S L)ᵀ and Cholesky's
+  // rounding errors are bounded by S M S's condition, not M's (Demmel 1989; Higham, Accuracy and
+  // Stability of Numerical Algorithms, 2nd ed., Thm. 10.7). Eigen's are unblocked below 32
+  // coordinates and a third of the LU's work: half the time of an evaluation of the middle ear
+  // was its blocked LU. The equilibrated LU's where they fail. False when M is singular to
+  // working precision: the ratio of the pivots (s_i² L_ii² of Cholesky's) bounds the reciprocal
+  // condition number of S M S from above (Eigen's rcond() estimate is 1 for an exactly singular
+  // matrix), and where it is below 1e-8 the condition estimate decides (a few solves more, so not
+  // at every evaluation of a well-conditioned M).
   bool factor_mass() {
-    scaled_ = M_;
-    detail::equilibrate(M_, scale_, scaled_);
     const double singular = static_cast<double>(n_) * std::numeric_limits<double>::epsilon();
-    llt_.compute(scaled_);
+    for (Index i = 0; i < n_; ++i) {
+      const double m = std::abs(M_(i, i));
+      scale_[i] = m > 0 && std::isfinite(m) ? 1 / std::sqrt(m) : 1.0;
+    }
+    llt_.compute(M_);
     if (llt_.info() == Eigen::Success) {
-      const auto d = llt_.matrixLLT().diagonal();
+      const VectorXd d = llt_.matrixLLT().diagonal().cwiseProduct(scale_);
       rcond_ = n_ > 0 ? std::pow(d.minCoeff() / d.maxCoeff(), 2) : 1.0;
-      if (rcond_ > singular && rcond_ < 1e-8) rcond_ = std::min(rcond_, llt_.rcond());
+      if (rcond_ > singular && rcond_ < 1e-8) {
+        scaled_ = M_;
+        detail::equilibrate(M_, scale_, scaled_);
+        rcond_ = std::min(rcond_, Eigen::LLT<MatrixXd>(scaled_).rcond());
+      }
       if ((cholesky_ = rcond_ > singular)) return true;
     }
     cholesky_ = false;
+    scaled_ = M_;
+    detail::equilibrate(M_, scale_, scaled_);
     lu_.compute(scaled_);
     rcond_ = detail::pivot_ratio(lu_);
     if (rcond_ > singular && rcond_ < 1e-8) rcond_ = std::min(rcond_, lu_.rcond());
@@ -275,8 +287,7 @@ class Equations : public detail::SecondOrderSystem {
       s = k_.mass_matrix(y, p_.data(), M_.data());
       if (s == 0) s = k_.residual(y, yd, u_.data(), p_.data(), r_.data());
     }
-    if (s != 0) return fail(t, s == 2 ? Failure::loops : Failure::non_finite);
-    return r_.allFinite() && M_.allFinite() ? true : fail(t, Failure::non_finite);
+    return s == 0 ? true : fail(t, s == 2 ? Failure::loops : Failure::non_finite);
   }
   bool fail(double t, Failure f) {
     failure = f;
@@ -288,7 +299,7 @@ class Equations : public detail::SecondOrderSystem {
   Index n_;
   const SimulationOptions& options_;
   MatrixXd M_;
-  VectorXd r_, u_, a_, scale_;
+  VectorXd r_, u_, a_, scale_, scaled_r_;
   MatrixXd scaled_;
   std::vector<double> anchor_, tree_;
   Eigen::LLT<MatrixXd> llt_;
