@@ -24,7 +24,8 @@ constexpr double kSafety = 0.9;
 // A Newton iteration on a fresh Jacobian that stops contracting with corrections below this (in
 // the error norm's units, where 1 is the tolerance) has reached the rounding in f: the middle ear
 // at rtol 1e-8, whose smallest motions' absolute tolerances (1e-17) are below its kernels'
-// rounding. Its iterate is kept (RADAU5 and SciPy halve the step instead, again and again).
+// rounding. Its iterate is kept, less a last correction that grew (RADAU5 and SciPy halve the
+// step instead, again and again); the error test then judges the step.
 constexpr double kStalled = 0.1;
 constexpr double kMaxGrowth = 10, kMinShrink = 0.2;  // per step
 
@@ -69,7 +70,7 @@ const Matrix3d kP = dense_output();
 double predicted_factor(double h, double h_old, double error, double error_old) {
   double multiplier = 1;
   if (h_old > 0 && error > 0 && error_old > 0) multiplier = h / h_old * std::pow(error_old / error, 0.25);
-  return error > 0 ? std::min(1.0, multiplier) * std::pow(error, -0.25) : kMaxGrowth;
+  return error == 0 ? kMaxGrowth : std::min(1.0, multiplier) * std::pow(error, -0.25);
 }
 
 }  // namespace
@@ -91,14 +92,15 @@ bool Radau::derivative(double t, const VectorXd& x, VectorXd& f) {
   return f.allFinite();
 }
 
-double Radau::norm(const VectorXd& e, const VectorXd& scale) const {
-  return std::sqrt((e.array() / scale.array()).square().mean());
+double Radau::norm(const VectorXd& e, const VectorXd& scale) const {  // RMS, without overflow
+  return e.size() == 0 ? 0.0 : (e.array() / scale.array()).matrix().stableNorm() / std::sqrt(static_cast<double>(e.size()));
 }
 
 bool Radau::start(double t, const VectorXd& x) {
   t_ = t;
   x_ = x;
   dense_ = false;
+  first_ = true;
   factored_ = false;
   faccon_ = 1;
   fresh_theta_ = 0;
@@ -251,21 +253,27 @@ bool Radau::newton(double h, int& iterations, double& theta) {
     for (int i = 0; i < 3; ++i) sum += (dW_.col(i).array() / scale_.array()).square().sum();
     const double dW_norm = std::sqrt(sum / static_cast<double>(3 * 2 * n_));
     if (!std::isfinite(dW_norm)) return false;
-    bool stalled = false;
     if (k > 1) {
       const double ratio = dW_norm / norm_old;
       theta = k == 2 ? ratio : std::sqrt(ratio * ratio_old);
       ratio_old = ratio;
       const bool slow = theta >= 0.99 || (theta / (1 - theta)) * dW_norm *
                                                  std::pow(theta, kNewtonIterations - 1 - k) >= newton_tol_;
-      stalled = slow && current_jacobian_ && dW_norm <= kStalled;  // at the rounding in f
-      if (slow && !stalled) return false;
-      if (!stalled) faccon_ = theta / (1 - theta);
+      if (slow && current_jacobian_ && dW_norm <= kStalled) {  // at the rounding in f
+        if (ratio < 1) {  // the correction still helps; one that grows is not taken
+          W_ += dW_;
+          Z_.noalias() = W_ * kT.transpose();
+        }
+        theta = kKeepJacobian;  // no rate to judge the Jacobian by (accept())
+        return true;
+      }
+      if (slow) return false;
+      faccon_ = theta / (1 - theta);
     }
     norm_old = std::max(dW_norm, kEpsilon);
     W_ += dW_;
     Z_.noalias() = W_ * kT.transpose();
-    if (stalled || faccon_ * dW_norm <= newton_tol_) return true;
+    if (faccon_ * dW_norm <= newton_tol_) return true;
   }
   return false;
 }
@@ -318,6 +326,7 @@ Radau::Status Radau::step(double t_stop) {
     if (!(h_ >= min_step)) return Status::step_too_small;
     const bool last = t_stop - t_ <= 1.1 * h_;
     const double h = last ? t_stop - t_ : h_;
+    h_unclamped_ = h_;
     const double t_new = last ? t_stop : t_ + h;
     scale_ = atol_.array() + rtol_ * x_.array().abs();
     int iterations = 0;
@@ -330,8 +339,14 @@ Radau::Status Radau::step(double t_stop) {
       continue;
     }
     x_new_ = x_ + Z_.col(2);
-    const double error = error_norm(h, x_new_, rejected || stats_.steps == 0);
+    const double error = error_norm(h, x_new_, rejected || first_);
     const double safety = kSafety * (2 * kNewtonIterations + 1) / (2 * kNewtonIterations + iterations);
+    if (!std::isfinite(error)) {  // no factor to predict from
+      ++stats_.rejected;
+      rejected = true;
+      h_ = 0.5 * h;
+      continue;
+    }
     if (!(error <= 1)) {
       ++stats_.rejected;
       rejected = true;
@@ -374,6 +389,9 @@ bool Radau::accept(double t_new, double h, double error, double safety, int iter
   // is still accepted by the next error test, and the middle ear then factors half as often.
   if (!recompute && factor < 1.2) factor = 1;
   h_ = h * factor;
+  // A step cut short to land on a stop says nothing against the step before it (RADAU5's HOPT).
+  if (h < h_unclamped_) h_ = std::max(h_, h_unclamped_);
+  first_ = false;
   if (!recompute) {
     current_jacobian_ = false;
     return true;

@@ -26,7 +26,7 @@ namespace mbsgen::detail {
 class SecondOrderSystem {
  public:
   virtual ~SecondOrderSystem() = default;
-  /// ÿ = −M⁻¹r at (t, y, v) (an LU of M); false where a kernel fails or M is singular.
+  /// ÿ = −M⁻¹r at (t, y, v) (a factorization of M); false where a kernel fails or M is singular.
   virtual bool accelerations(double t, const double* y, const double* v, Eigen::VectorXd& a) = 0;
   /// Whether jacobian() is available (else the integrator takes difference quotients).
   virtual bool has_jacobian() const = 0;
@@ -68,7 +68,6 @@ class Radau {
   bool residuals(double h);
   bool try_step(double h, int& iterations, double& theta);
   bool evaluate_jacobian(double t, const Eigen::VectorXd& x);
-  void difference_quotients(double t, const Eigen::VectorXd& x);
   bool factor(double h);
   void solve_real(const double* b, double* out);
   void solve_complex(const double* b_re, const double* b_im, double* out_re, double* out_im);
@@ -83,8 +82,9 @@ class Radau {
   Eigen::VectorXd atol_;
   double newton_tol_;
 
-  double t_ = 0, h_ = 0, h_old_ = 0, error_old_ = 0, t_old_ = 0, h_last_ = 0;
+  double t_ = 0, h_ = 0, h_old_ = 0, error_old_ = 0, t_old_ = 0, h_last_ = 0, h_unclamped_ = 0;
   bool dense_ = false;         // a previous step's polynomial to start Newton from
+  bool first_ = true;          // no step accepted since start()
   bool current_jacobian_ = false;
   bool jacobian_failed_ = false;
   bool factored_ = false;

@@ -199,8 +199,14 @@ class Equations : public detail::SecondOrderSystem {
       const double m = std::abs(M_(i, i));
       scale_[i] = m > 0 && std::isfinite(m) ? 1 / std::sqrt(m) : 1.0;
     }
-    llt_.compute(M_);
-    if (llt_.info() == Eigen::Success) {
+    // Cholesky reads one triangle: only for an M symmetric to rounding in its equilibrated units
+    // (the generator's is, by construction; anything else takes the LU, which reads all of it).
+    double asymmetry = 0;
+    for (Index j = 0; j < n_; ++j)
+      for (Index i = j + 1; i < n_; ++i)
+        asymmetry = std::max(asymmetry, std::abs(M_(i, j) - M_(j, i)) * scale_[i] * scale_[j]);
+    if (asymmetry <= 1e-10) llt_.compute(M_);
+    if (asymmetry <= 1e-10 && llt_.info() == Eigen::Success) {
       const VectorXd d = llt_.matrixLLT().diagonal().cwiseProduct(scale_);
       rcond_ = n_ > 0 ? std::pow(d.minCoeff() / d.maxCoeff(), 2) : 1.0;
       if (rcond_ > singular && rcond_ < 1e-8) {
@@ -404,6 +410,9 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   positive(o.duration, "the duration");
   positive(o.step, "the output step");
   positive(o.rtol, "rtol");
+  if (o.method == IntegrationMethod::radau && o.rtol < 100 * std::numeric_limits<double>::epsilon())
+    throw Error("simulate: --method radau needs rtol of at least 100 ε = 2.2e-14 (its Newton iteration stops at "
+                "10 ε / rtol of the tolerance), got " + std::to_string(o.rtol));
   positive(o.atol, "atol");
   absolute_tolerances(k, o);  // the names and values of atol_of
   const double values = (o.duration / o.step + 1) * (2.0 * k.n_coordinates + k.n_inputs + k.n_outputs);
@@ -665,15 +674,18 @@ class RadauIntegrator : public Integrator {
   double step(double, double stop) override {
     const auto status = radau_.step(stop);
     if (status == detail::Radau::Status::ok) return radau_.time();
-    const double h = radau_.step_size();
-    double t = radau_.time();
-    std::string why = "the integrator cannot advance (step size " + short_number(h) +
-                      " s): its error test or Newton iteration keeps failing (the motion is too fast there, or the "
-                      "forces or parameters are far out of range?)";
-    if (eq_.failure != Equations::Failure::none && std::isfinite(eq_.failed_time)) {
-      t = eq_.failed_time;
-      why = eq_.reason();
+    const double t = radau_.time();
+    std::string why;
+    if (status == detail::Radau::Status::failed) {
+      why = "the Jacobian cannot be evaluated at the state reached";
+    } else {
+      why = "the integrator cannot advance (step size " + short_number(radau_.step_size()) +
+            " s): its error test or Newton iteration keeps failing (the motion is too fast there, or the forces or "
+            "parameters are far out of range?)";
     }
+    // The cause the kernels or M gave, as a likely one: the step may have failed on its own.
+    if (eq_.failure != Equations::Failure::none && std::isfinite(eq_.failed_time))
+      why += "; the last evaluation that failed on the way, at t = " + short_number(eq_.failed_time) + " s: " + eq_.reason();
     throw SimulationError("simulate: the integration stopped " + at_time(t) + ": " + why, t);
   }
   void restart(double t, SimulationResult&) override {
