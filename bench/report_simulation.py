@@ -52,7 +52,7 @@ def simulation_section(results, table):
            "call the same generated kernels (a shared library through ctypes; M ÿ = −(k − q) by "
            "`numpy.linalg.solve`), so the difference is the integrators and the language around them. Error: "
            "the largest difference of a coordinate from a reference run (our Radau at rtol 1e-13; the middle "
-           "ear's 1e-11: at ten times the tolerance it is 8e-12, 1.4e-10 and 5e-12 off itself), relative "
+           "ear's 1e-11: at ten times the tolerance it is 1e-11, 2.7e-10 and 3e-12 off itself), relative "
            "to the largest coordinate, over all samples; atol = rtol (the middle ear: "
            "rtol × 1e-9 m). Times are medians (ours of 5 runs, SciPy's of 3). `bench/simulation_timing`, "
            "`bench/simulation_compare.py`.", ""]
