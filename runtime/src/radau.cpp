@@ -1,6 +1,8 @@
 // Radau IIA of order 5 on M(y) ÿ + r(y, ẏ, t) = 0 (radau.hpp).
 #include "radau.hpp"
 
+#include "second_order_newton.hpp"
+
 #include <Eigen/LU>
 
 #include <algorithm>
@@ -143,10 +145,7 @@ bool Radau::evaluate_jacobian(double t, const VectorXd& x) {
     }
   }
   if (!(MJ_.allFinite() && Ky_.allFinite() && Kv_.allFinite())) return false;
-  for (Index i = 0; i < n_; ++i) {
-    const double d = std::abs(MJ_(i, i));
-    equilibrate_[i] = d > 0 && std::isfinite(d) ? 1 / std::sqrt(d) : 1.0;
-  }
+  mass_scale(MJ_, equilibrate_);
   return true;
 }
 

@@ -123,12 +123,16 @@ int solver_free(SUNLinearSolver S) {
 
 }  // namespace
 
-void equilibrate(const MatrixXd& M, VectorXd& scale, MatrixXd& A) {
-  const Index n = M.rows();
-  for (Index i = 0; i < n; ++i) {
+void mass_scale(const MatrixXd& M, VectorXd& scale) {
+  for (Index i = 0; i < M.rows(); ++i) {
     const double m = std::abs(M(i, i));
     scale[i] = m > 0 && std::isfinite(m) ? 1 / std::sqrt(m) : 1.0;
   }
+}
+
+void equilibrate(const MatrixXd& M, VectorXd& scale, MatrixXd& A) {
+  const Index n = M.rows();
+  mass_scale(M, scale);
   for (Index j = 0; j < n; ++j)
     for (Index i = 0; i < n; ++i) A(i, j) = scale[i] * A(i, j) * scale[j];
 }

@@ -20,9 +20,11 @@
 
 namespace mbsgen::detail {
 
-/// Equilibration by the mass matrix: scale = diag(|M_ii|)^(-1/2) (1 where M_ii is 0 or not
-/// finite), and A := S A S in place (its pivots then do not depend on the units: kg against
-/// kg m²). For M's LU per evaluation (simulation.cpp) and for the reduced Newton matrix.
+/// The mass matrix's equilibration: scale = diag(|M_ii|)^(-1/2) (1 where M_ii is 0 or not
+/// finite), so that S M S's pivots do not depend on the units (kg against kg m²).
+void mass_scale(const Eigen::MatrixXd& M, Eigen::VectorXd& scale);
+/// mass_scale(M, scale), and A := S A S in place. For M's LU per evaluation (simulation.cpp)
+/// and for the reduced Newton matrix.
 void equilibrate(const Eigen::MatrixXd& M, Eigen::VectorXd& scale, Eigen::MatrixXd& A);
 /// The smallest over the largest |pivot| of an LU (1 for an empty matrix): an upper bound of the
 /// reciprocal condition number (NaN, never above n·ε, for a zero matrix).

@@ -1,4 +1,5 @@
-// simulate(): SUNDIALS CVODE on x' = (v, −M(y)⁻¹ (k − q)(y, v, u(t))), x = (y, v) (simulation.hpp).
+// simulate(): SUNDIALS CVODE, or our Radau IIA (radau.hpp), on x' = (v, −M(y)⁻¹ (k − q)(y, v, u(t))),
+// x = (y, v) (simulation.hpp).
 #include "mbsgen/runtime/simulation.hpp"
 
 #include "radau.hpp"
@@ -195,18 +196,21 @@ class Equations : public detail::SecondOrderSystem {
   // at every evaluation of a well-conditioned M).
   bool factor_mass() {
     const double singular = static_cast<double>(n_) * std::numeric_limits<double>::epsilon();
-    for (Index i = 0; i < n_; ++i) {
-      const double m = std::abs(M_(i, i));
-      scale_[i] = m > 0 && std::isfinite(m) ? 1 / std::sqrt(m) : 1.0;
-    }
+    detail::mass_scale(M_, scale_);
     // Cholesky reads one triangle: only for an M symmetric to rounding in its equilibrated units
     // (the generator's is, by construction; anything else takes the LU, which reads all of it).
-    double asymmetry = 0;
-    for (Index j = 0; j < n_; ++j)
-      for (Index i = j + 1; i < n_; ++i)
-        asymmetry = std::max(asymmetry, std::abs(M_(i, j) - M_(j, i)) * scale_[i] * scale_[j]);
-    if (asymmetry <= 1e-10) llt_.compute(M_);
-    if (asymmetry <= 1e-10 && llt_.info() == Eigen::Success) {
+    // Symmetry is a property of the kernels, not of the state: judged at the first evaluation,
+    // not at every one.
+    if (!symmetry_known_) {
+      double asymmetry = 0;
+      for (Index j = 0; j < n_; ++j)
+        for (Index i = j + 1; i < n_; ++i)
+          asymmetry = std::max(asymmetry, std::abs(M_(i, j) - M_(j, i)) * scale_[i] * scale_[j]);
+      symmetric_ = asymmetry <= 1e-10;
+      symmetry_known_ = true;
+    }
+    if (symmetric_) llt_.compute(M_);
+    if (symmetric_ && llt_.info() == Eigen::Success) {
       const VectorXd d = llt_.matrixLLT().diagonal().cwiseProduct(scale_);
       rcond_ = n_ > 0 ? std::pow(d.minCoeff() / d.maxCoeff(), 2) : 1.0;
       if (rcond_ > singular && rcond_ < 1e-8) {
@@ -227,12 +231,9 @@ class Equations : public detail::SecondOrderSystem {
   // M, K_y(y, ẏ, ÿ) and K_v after evaluate() at the same state: the Jacobian's parts
   // (second_order_newton.hpp).
   bool jacobian(double t, const double* y, const double* yd, detail::SecondOrderMatrix& J) {
-    if (k_.dynamics_jacobian(y, yd, a_.data(), u_.data(), p_.data(), J.Ky.data(), J.Kv.data()) != 0)
-      return fail(t, Failure::non_finite);
-    J.M = M_;
     J.c = 1;
     J.d = 0;
-    return J.Ky.allFinite() && J.Kv.allFinite() ? true : fail(t, Failure::non_finite);
+    return jacobian_kernel(t, y, yd, J.M, J.Ky, J.Kv);
   }
   const VectorXd& accelerations() const { return a_; }
   const std::vector<double>& parameters() const { return p_; }
@@ -251,11 +252,7 @@ class Equations : public detail::SecondOrderSystem {
   }
   bool has_jacobian() const override { return analytic_jacobian(); }
   bool jacobian(double t, const double* y, const double* yd, MatrixXd& M, MatrixXd& Ky, MatrixXd& Kv) override {
-    if (!evaluate(t, y, yd)) return false;
-    if (k_.dynamics_jacobian(y, yd, a_.data(), u_.data(), p_.data(), Ky.data(), Kv.data()) != 0)
-      return fail(t, Failure::non_finite);
-    M = M_;
-    return Ky.allFinite() && Kv.allFinite() ? true : fail(t, Failure::non_finite);
+    return evaluate(t, y, yd) && jacobian_kernel(t, y, yd, M, Ky, Kv);
   }
 
   enum class Failure { none, non_finite, loops, singular_mass, exception };
@@ -281,6 +278,13 @@ class Equations : public detail::SecondOrderSystem {
   }
 
  private:
+  // M, K_y and K_v from the Jacobian kernel, after evaluate() at the same state.
+  bool jacobian_kernel(double t, const double* y, const double* yd, MatrixXd& M, MatrixXd& Ky, MatrixXd& Kv) {
+    if (k_.dynamics_jacobian(y, yd, a_.data(), u_.data(), p_.data(), Ky.data(), Kv.data()) != 0)
+      return fail(t, Failure::non_finite);
+    M = M_;
+    return Ky.allFinite() && Kv.allFinite() ? true : fail(t, Failure::non_finite);
+  }
   // M and k − q at (y, ẏ) and the inputs u_.
   bool kernels(double t, const double* y, const double* yd) {
     int s = 0;
@@ -311,6 +315,7 @@ class Equations : public detail::SecondOrderSystem {
   Eigen::LLT<MatrixXd> llt_;
   Eigen::PartialPivLU<MatrixXd> lu_;
   bool cholesky_ = false;  // the last factor_mass() kept llt_
+  bool symmetry_known_ = false, symmetric_ = false;  // of M (factor_mass())
   double rcond_ = 0, segment_start_ = 0;
 };
 
@@ -664,7 +669,7 @@ class CvodeIntegrator : public Integrator {
   double reached_ = 0;
 };
 
-// Radau IIA (radau.hpp) on the implicit form.
+// Radau IIA (radau.hpp).
 class RadauIntegrator : public Integrator {
  public:
   RadauIntegrator(Equations& eq, const SimulationOptions& o, const VectorXd& x0)

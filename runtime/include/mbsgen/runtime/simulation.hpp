@@ -1,13 +1,15 @@
 // Time-domain simulation of the nonlinear equations of motion M(y) ÿ + k(y, ẏ) − q(y, ẏ, u) = 0
-// of a generated model (issue 18), by SUNDIALS CVODE on the explicit first-order form
+// of a generated model (issue 18), on the explicit first-order form
 //
 //   x' = (v, ÿ),   ÿ = −M(y)⁻¹ (k − q)(y, v, u(t)),   x = (y, v),
 //
-// with an LU factorization of M at each right-hand side (a singular M is reported where it
-// occurs). Two methods: BDF (orders 1–5, for stiff models such as the middle ear) with Newton's
-// iteration on the Jacobian ∂x'/∂x = [0, I; −M⁻¹ K_y, −M⁻¹ K_v] from the generated kernel
-// `dynamics_jacobian` (K_y = ∂(M ÿ + k − q)/∂y at the current ÿ, K_v = ∂(k − q)/∂ẏ), or from
-// difference quotients for kernels generated without it; and Adams–Moulton (orders 1–12, with
+// with a factorization of M at each right-hand side (Cholesky's, the LU's where it fails; a
+// singular M is reported where it occurs). Three methods: Radau IIA of order 5 (ours, after
+// RADAU5: stiff and oscillating motion, tight tolerances), and SUNDIALS CVODE's BDF (orders 1–5,
+// for stiff models such as the middle ear) with Newton's iteration on the Jacobian
+// ∂x'/∂x = [0, I; −M⁻¹ K_y, −M⁻¹ K_v] from the generated kernel `dynamics_jacobian`
+// (K_y = ∂(M ÿ + k − q)/∂y at the current ÿ, K_v = ∂(k − q)/∂ẏ), or from difference quotients
+// for kernels generated without it; and Adams–Moulton (orders 1–12, with
 // fixed-point iteration) for non-stiff motion, where its higher order takes fewer and more
 // accurate steps (a pendulum, a conservative linkage). docs/simulation.md compares them and says
 // why CVODE rather than IDA.
