@@ -2,6 +2,7 @@
 // x = (y, v) (simulation.hpp).
 #include "mbsgen/runtime/simulation.hpp"
 
+#include "block_cholesky.hpp"
 #include "radau.hpp"
 #include "second_order_newton.hpp"
 
@@ -106,7 +107,7 @@ class Equations : public detail::SecondOrderSystem {
  public:
   Equations(const GeneratedModel& model, const SimulationOptions& o)
       : k_(model.kernels()), p_(model.parameters()), n_(k_.n_coordinates), options_(o),
-        M_(n_, n_), r_(n_), u_(k_.n_inputs), a_(n_), scale_(n_), scaled_r_(n_), scaled_(n_, n_), llt_(n_), lu_(n_) {}
+        M_(n_, n_), r_(n_), u_(k_.n_inputs), a_(n_), scale_(n_), scaled_r_(n_), scaled_(n_, n_), cholesky_factors_(n_), lu_(n_) {}
 
   // Closed loops, followed through any range: the tree's coordinates at the last accepted step
   // (`anchor_`), from which every evaluation closes the loops again (assemble_from).
@@ -173,8 +174,7 @@ class Equations : public detail::SecondOrderSystem {
     if (!kernels(t, y, yd)) return false;
     if (!factor_mass()) return fail(t, Failure::singular_mass);
     if (cholesky_) {  // ÿ = −M⁻¹ (k − q)
-      a_.noalias() = llt_.solve(r_);
-      a_ = -a_;
+      cholesky_factors_.solve_negated(r_, a_);
     } else {  // ÿ = −S (S M S)⁻¹ S (k − q)
       scaled_r_ = r_.cwiseProduct(scale_);
       a_.noalias() = lu_.solve(scaled_r_);
@@ -189,7 +189,8 @@ class Equations : public detail::SecondOrderSystem {
   // rounding errors are bounded by S M S's condition, not M's (Demmel 1989; Higham, Accuracy and
   // Stability of Numerical Algorithms, 2nd ed., Thm. 10.7). Eigen's are unblocked below 32
   // coordinates and a third of the LU's work: half the time of an evaluation of the middle ear
-  // was its blocked LU. The equilibrated LU's where they fail. False when M is singular to
+  // was its blocked LU. Block by block where M is block diagonal (block_cholesky.hpp: the middle
+  // ear's three bodies). The equilibrated LU's where they fail. False when M is singular to
   // working precision: the ratio of the pivots (s_i² L_ii² of Cholesky's) bounds the reciprocal
   // condition number of S M S from above (Eigen's rcond() estimate is 1 for an exactly singular
   // matrix), and where it is below 1e-8 the condition estimate decides (a few solves more, so not
@@ -209,9 +210,8 @@ class Equations : public detail::SecondOrderSystem {
       symmetric_ = asymmetry <= 1e-10;
       symmetry_known_ = true;
     }
-    if (symmetric_) llt_.compute(M_);
-    if (symmetric_ && llt_.info() == Eigen::Success) {
-      const VectorXd d = llt_.matrixLLT().diagonal().cwiseProduct(scale_);
+    if (symmetric_ && cholesky_factors_.compute(M_)) {
+      const VectorXd d = cholesky_factors_.diagonal().cwiseProduct(scale_);
       rcond_ = n_ > 0 ? std::pow(d.minCoeff() / d.maxCoeff(), 2) : 1.0;
       if (rcond_ > singular && rcond_ < 1e-8) {
         scaled_ = M_;
@@ -312,9 +312,9 @@ class Equations : public detail::SecondOrderSystem {
   VectorXd r_, u_, a_, scale_, scaled_r_;
   MatrixXd scaled_;
   std::vector<double> anchor_, tree_;
-  Eigen::LLT<MatrixXd> llt_;
+  detail::BlockCholesky cholesky_factors_;  // M's, block by block where it is block diagonal
   Eigen::PartialPivLU<MatrixXd> lu_;
-  bool cholesky_ = false;  // the last factor_mass() kept llt_
+  bool cholesky_ = false;  // the last factor_mass() kept cholesky_factors_
   bool symmetry_known_ = false, symmetric_ = false;  // of M (factor_mass())
   double rcond_ = 0, segment_start_ = 0;
 };

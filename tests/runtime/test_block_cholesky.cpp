@@ -1,0 +1,119 @@
+// The mass matrix's Cholesky factors block by block (runtime/src/block_cholesky.hpp) against
+// Eigen's LLT of the whole matrix: the same solutions to rounding, for blocks of fixed (≤ 8) and
+// dynamic size interleaved in the coordinates, after a coupling entry appears (the blocks merge)
+// and for a dense M; a block that is not positive definite is reported.
+#include "block_cholesky.hpp"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace {
+
+using Eigen::Index;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+using mbsgen::detail::BlockCholesky;
+
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+
+// A symmetric positive definite matrix on the coordinates `owner[i] == b` for each block b,
+// zero between blocks; the blocks' coordinates interleaved (owner), condition below 10 each.
+MatrixXd block_diagonal(const std::vector<int>& owner, int blocks) {
+  const Index n = static_cast<Index>(owner.size());
+  MatrixXd M = MatrixXd::Zero(n, n);
+  for (int b = 0; b < blocks; ++b) {
+    std::vector<Index> index;
+    for (Index i = 0; i < n; ++i)
+      if (owner[static_cast<std::size_t>(i)] == b) index.push_back(i);
+    const Index k = static_cast<Index>(index.size());
+    const MatrixXd R = MatrixXd::Random(k, k);
+    const MatrixXd B = R * R.transpose() + static_cast<double>(k) * MatrixXd::Identity(k, k);
+    for (Index c = 0; c < k; ++c)
+      for (Index r = 0; r < k; ++r) M(index[static_cast<std::size_t>(r)], index[static_cast<std::size_t>(c)]) = (b + 1) * B(r, c);
+  }
+  return M;
+}
+
+// −M⁻¹b from the blocks against Eigen's LLT of M: both backward stable, so they agree to a few
+// ε times M's condition (below 10 per block, times the blocks' scales 1 to 4: below 100).
+void expect_same_solution(BlockCholesky& factors, const MatrixXd& M) {
+  const VectorXd b = VectorXd::Random(M.rows());
+  VectorXd x(M.rows());
+  factors.solve_negated(b, x);
+  const VectorXd expected = -M.llt().solve(b);
+  EXPECT_LE((x - expected).norm(), 100 * 100 * kEpsilon * expected.norm());
+  EXPECT_LE((M * x + b).norm(), 100 * kEpsilon * M.norm() * x.norm());
+}
+
+TEST(BlockCholesky, InterleavedBlocksOfFixedAndDynamicSize) {
+  std::srand(3);
+  // Blocks of 1, 3, 6 and 10 coordinates (10 > 8: a dynamic one), interleaved.
+  std::vector<int> owner;
+  const int sizes[4] = {1, 3, 6, 10};
+  for (int round = 0; round < 10; ++round)
+    for (int b = 0; b < 4; ++b)
+      if (round < sizes[b]) owner.push_back(b);
+  const MatrixXd M = block_diagonal(owner, 4);
+  BlockCholesky factors(M.rows());
+  ASSERT_TRUE(factors.compute(M));
+  EXPECT_EQ(factors.blocks(), 4U);
+  expect_same_solution(factors, M);
+  // L's diagonal: the pivots of M's Cholesky factor in M's order; their squares' product is det M.
+  EXPECT_NEAR(2 * factors.diagonal().array().log().sum(), std::log(M.determinant()), 1e-10 * M.rows());
+}
+
+TEST(BlockCholesky, ACouplingEntryMergesTheBlocks) {
+  std::srand(5);
+  const std::vector<int> owner = {0, 1, 0, 1, 2, 2, 0};
+  MatrixXd M = block_diagonal(owner, 3);
+  BlockCholesky factors(M.rows());
+  ASSERT_TRUE(factors.compute(M));
+  EXPECT_EQ(factors.blocks(), 3U);
+  M(3, 0) = M(0, 3) = 0.3;  // blocks 0 and 1 now share an entry: the old blocks would be wrong
+  ASSERT_TRUE(factors.compute(M));
+  EXPECT_EQ(factors.blocks(), 2U);
+  expect_same_solution(factors, M);
+  // Only the lower triangle is read, as Eigen's LLT reads it: an entry above the diagonal alone
+  // couples nothing.
+  MatrixXd U = block_diagonal(owner, 3);
+  U(0, 4) = 0.2;
+  BlockCholesky upper(U.rows());
+  ASSERT_TRUE(upper.compute(U));
+  EXPECT_EQ(upper.blocks(), 3U);
+  const VectorXd b = VectorXd::Random(U.rows());
+  VectorXd x(U.rows());
+  upper.solve_negated(b, x);
+  const VectorXd expected = -U.llt().solve(b);
+  EXPECT_LE((x - expected).norm(), 1e4 * kEpsilon * expected.norm());
+}
+
+TEST(BlockCholesky, DenseMatrixAndEmptyMatrix) {
+  std::srand(9);
+  const MatrixXd R = MatrixXd::Random(12, 12);
+  const MatrixXd M = R * R.transpose() + 12 * MatrixXd::Identity(12, 12);
+  BlockCholesky factors(12);
+  ASSERT_TRUE(factors.compute(M));
+  EXPECT_EQ(factors.blocks(), 1U);
+  expect_same_solution(factors, M);
+  BlockCholesky none(0);
+  EXPECT_TRUE(none.compute(MatrixXd(0, 0)));
+}
+
+TEST(BlockCholesky, ABlockThatIsNotPositiveDefiniteFails) {
+  std::srand(11);
+  const std::vector<int> owner = {0, 1, 1, 0, 2};
+  MatrixXd M = block_diagonal(owner, 3);
+  BlockCholesky factors(M.rows());
+  ASSERT_TRUE(factors.compute(M));
+  M(4, 4) = -1;  // a 1×1 block
+  EXPECT_FALSE(factors.compute(M));
+  M = block_diagonal(owner, 3);
+  M(2, 1) = M(1, 2) = 2 * std::sqrt(M(1, 1) * M(2, 2));  // the 2×2 block is indefinite
+  EXPECT_FALSE(factors.compute(M));
+}
+
+}  // namespace
