@@ -25,12 +25,9 @@ BlockCholesky::BlockCholesky(Index n) : n_(n), block_of_(at(n), 0), diagonal_(n)
 
 // Whether every entry of M's lower triangle outside the blocks is zero.
 bool BlockCholesky::partition_holds(const MatrixXd& M) const {
-  if (blocks_.size() == 1) return true;  // one block holds any M
-  for (Index j = 0; j < n_; ++j) {
-    const int b = block_of_[at(j)];
-    for (Index i = j + 1; i < n_; ++i)
-      if (block_of_[at(i)] != b && M(i, j) != 0) return false;
-  }
+  const double* m = M.data();
+  for (const Index k : outside_)
+    if (m[k] != 0) return false;
   return true;
 }
 
@@ -61,6 +58,10 @@ void BlockCholesky::partition(const MatrixXd& M) {
     block_of_[at(i)] = b;
   }
   if (n_ == 0) blocks_.emplace_back();
+  outside_.clear();
+  for (Index j = 0; j < n_; ++j)
+    for (Index i = j + 1; i < n_; ++i)
+      if (block_of_[at(i)] != block_of_[at(j)]) outside_.push_back(i + j * n_);
   factors_.clear();
   for (const std::vector<Index>& block : blocks_) {
     const Index size = static_cast<Index>(block.size());

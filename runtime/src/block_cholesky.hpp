@@ -52,6 +52,7 @@ class BlockCholesky {
   Eigen::Index n_;
   std::vector<std::vector<Eigen::Index>> blocks_;  // the coordinates of each block, ascending
   std::vector<int> block_of_;                        // each coordinate's block
+  std::vector<Eigen::Index> outside_;                // M's lower entries between blocks (column-major)
   std::vector<Factors> factors_;
   bool whole_ = false;  // one dynamic block of all coordinates: M factored in place
   Eigen::VectorXd diagonal_;

@@ -197,12 +197,12 @@ class Equations : public detail::SecondOrderSystem {
   // at every evaluation of a well-conditioned M).
   bool factor_mass() {
     const double singular = static_cast<double>(n_) * std::numeric_limits<double>::epsilon();
-    detail::mass_scale(M_, scale_);
     // Cholesky reads one triangle: only for an M symmetric to rounding in its equilibrated units
     // (the generator's is, by construction; anything else takes the LU, which reads all of it).
     // Symmetry is a property of the kernels, not of the state: judged at the first evaluation,
     // not at every one.
     if (!symmetry_known_) {
+      detail::mass_scale(M_, scale_);
       double asymmetry = 0;
       for (Index j = 0; j < n_; ++j)
         for (Index i = j + 1; i < n_; ++i)
@@ -211,8 +211,15 @@ class Equations : public detail::SecondOrderSystem {
       symmetry_known_ = true;
     }
     if (symmetric_ && cholesky_factors_.compute(M_)) {
-      const VectorXd d = cholesky_factors_.diagonal().cwiseProduct(scale_);
-      rcond_ = n_ > 0 ? std::pow(d.minCoeff() / d.maxCoeff(), 2) : 1.0;
+      // The squared pivots of S M S, s_i² L_ii² = L_ii² / |M_ii| (non-finite: singular).
+      double smallest = n_ > 0 ? kInfinity : 1.0, largest = n_ > 0 ? 0.0 : 1.0;
+      for (Index i = 0; i < n_; ++i) {
+        const double L = cholesky_factors_.diagonal()[i], d = L * L / std::abs(M_(i, i));
+        if (!std::isfinite(d)) smallest = 0;
+        smallest = std::min(smallest, d);
+        largest = std::max(largest, d);
+      }
+      rcond_ = smallest / largest;
       if (rcond_ > singular && rcond_ < 1e-8) {
         scaled_ = M_;
         detail::equilibrate(M_, scale_, scaled_);
