@@ -1,6 +1,8 @@
 // Cholesky factors of a block-diagonal mass matrix, block by block (block_cholesky.hpp).
 #include "block_cholesky.hpp"
 
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <type_traits>
 
@@ -13,6 +15,8 @@ using Eigen::VectorXd;
 namespace {
 
 constexpr Index kLargestFixed = 8;
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+constexpr int kCorrections = 5;  // LAPACK xPORFS's ITMAX
 
 template <int N>
 using FixedMatrix = Eigen::Matrix<double, N, N>;
@@ -110,6 +114,7 @@ bool BlockCholesky::compute(const MatrixXd& M) {
             for (Index c = 0; c < G.cols(); ++c)
               for (Index r = c; r < G.rows(); ++r) G(r, c) = M(index[at(r)], index[at(c)]);
             f.llt.compute(G);
+            if (f.llt.info() == Eigen::Success) f.inverse = f.llt.solve(Matrix::Identity());
           }
           if (f.llt.info() != Eigen::Success) return false;
           for (std::size_t r = 0; r < index.size(); ++r)
@@ -117,6 +122,69 @@ bool BlockCholesky::compute(const MatrixXd& M) {
           return true;
         },
         factors_[b]);
+    if (!ok) return false;
+  }
+  return true;
+}
+
+namespace {
+
+// The block's share of solve_refined(): y = −G⁻¹ c from the inverse P of a nearby block, by
+// y ← y + P (−c − G y). Its componentwise backward error max_i |c + G y|_i / (|G| |y| + |c|)_i
+// (the denominators from the first iterate: later ones differ from it by the corrections, a
+// hundredth at most) must reach 4·size·ε, or stagnate there.
+template <class Matrix, class Vector>
+bool refine_block(const Matrix& G, const Matrix& P, const Vector& c, Vector& y) {
+  y.noalias() = -(P * c);
+  Vector scale = c.cwiseAbs();
+  scale.noalias() += G.cwiseAbs() * y.cwiseAbs();
+  scale.array() += std::numeric_limits<double>::min();  // a zero row: 0/min = 0, not NaN
+  const double goal = 4 * static_cast<double>(G.rows()) * kEpsilon;
+  double first = 0, last = 0;
+  for (int k = 0; k <= kCorrections; ++k) {
+    Vector residual = -c;
+    residual.noalias() -= G * y;
+    const auto ratio = residual.cwiseAbs().array() / scale.array();
+    if ((ratio <= goal).all()) return true;  // (false for a NaN)
+    if (!ratio.allFinite()) return false;
+    const double error = ratio.maxCoeff();
+    if (k == 1 && !(error <= 1e-2 * first)) return false;  // M has moved too far
+    if (k >= 2 && !(error <= 0.5 * last)) return false;   // stagnates above the goal
+    if (k == 0) first = error;
+    last = error;
+    if (k == kCorrections) return false;
+    y.noalias() += P * residual;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool BlockCholesky::solve_refined(const MatrixXd& M, const VectorXd& b, VectorXd& x) {
+  if (whole_ || blocks_.empty() || !partition_holds(M)) return false;
+  for (std::size_t k = 0; k < blocks_.size(); ++k) {
+    const std::vector<Index>& index = blocks_[k];
+    const bool ok = std::visit(
+        [&](auto& f) {
+          using F = std::decay_t<decltype(f)>;
+          if constexpr (std::is_same_v<F, Dynamic>) {
+            return false;
+          } else {
+            using Matrix = typename std::decay_t<decltype(f.llt)>::MatrixType;
+            using Vector = Eigen::Matrix<double, Matrix::RowsAtCompileTime, 1>;
+            Matrix G;
+            Vector c, y;
+            for (Index j = 0; j < G.cols(); ++j) {
+              c[j] = b[index[at(j)]];
+              for (Index i = 0; i < G.rows(); ++i)  // the lower triangle's matrix, as compute() reads it
+                G(i, j) = i >= j ? M(index[at(i)], index[at(j)]) : M(index[at(j)], index[at(i)]);
+            }
+            if (!refine_block(G, f.inverse, c, y)) return false;
+            for (Index i = 0; i < y.size(); ++i) x[index[at(i)]] = y[i];
+            return true;
+          }
+        },
+        factors_[k]);
     if (!ok) return false;
   }
   return true;

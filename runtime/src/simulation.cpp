@@ -172,17 +172,24 @@ class Equations : public detail::SecondOrderSystem {
   bool evaluate(double t, const double* y, const double* yd, bool signal_values = false) {
     if (signal_values) inputs_at(t); else inputs(t);
     if (!kernels(t, y, yd)) return false;
-    if (!factor_mass()) return fail(t, Failure::singular_mass);
-    if (cholesky_) {  // ÿ = −M⁻¹ (k − q)
-      cholesky_factors_.solve_negated(r_, a_);
-    } else {  // ÿ = −S (S M S)⁻¹ S (k − q)
-      scaled_r_ = r_.cwiseProduct(scale_);
-      a_.noalias() = lu_.solve(scaled_r_);
-      a_.array() *= -scale_.array();
+    const bool refined = cholesky_ && !factor_next_ && cholesky_factors_.solve_refined(M_, r_, a_);
+    factor_next_ = false;
+    if (!refined) {
+      if (!factor_mass()) return fail(t, Failure::singular_mass);
+      if (cholesky_) {  // ÿ = −M⁻¹ (k − q)
+        cholesky_factors_.solve_negated(r_, a_);
+      } else {  // ÿ = −S (S M S)⁻¹ S (k − q)
+        scaled_r_ = r_.cwiseProduct(scale_);
+        a_.noalias() = lu_.solve(scaled_r_);
+        a_.array() *= -scale_.array();
+      }
     }
     if (!a_.allFinite()) return fail(t, Failure::non_finite);
     return true;
   }
+  // The next evaluate() factors M afresh (its singularity judged again), rather than refining
+  // on the last factors: at the Jacobian's state.
+  void factor_next() { factor_next_ = true; }
   // The factors of M, judged by those of the equilibrated S M S, S = diag(|M_ii|)^(-1/2) (whose
   // pivots do not depend on the units: kg against kg m²). A mass matrix is symmetric positive
   // definite: Cholesky's factors first, of M itself, since S M S = (S L)(S L)ᵀ and Cholesky's
@@ -252,6 +259,7 @@ class Equations : public detail::SecondOrderSystem {
     return true;
   }
   bool jacobian_mass(double t, const double* y, const double* yd, MatrixXd& M, VectorXd& a) override {
+    factor_next();
     if (!evaluate(t, y, yd)) return false;
     M = M_;
     a = a_;
@@ -259,6 +267,7 @@ class Equations : public detail::SecondOrderSystem {
   }
   bool has_jacobian() const override { return analytic_jacobian(); }
   bool jacobian(double t, const double* y, const double* yd, MatrixXd& M, MatrixXd& Ky, MatrixXd& Kv) override {
+    factor_next();
     return evaluate(t, y, yd) && jacobian_kernel(t, y, yd, M, Ky, Kv);
   }
 
@@ -322,6 +331,7 @@ class Equations : public detail::SecondOrderSystem {
   detail::BlockCholesky cholesky_factors_;  // M's, block by block where it is block diagonal
   Eigen::PartialPivLU<MatrixXd> lu_;
   bool cholesky_ = false;  // the last factor_mass() kept cholesky_factors_
+  bool factor_next_ = false;  // factor_next()
   bool symmetry_known_ = false, symmetric_ = false;  // of M (factor_mass())
   double rcond_ = 0, segment_start_ = 0;
 };
@@ -352,6 +362,7 @@ int jacobian_function(realtype t, N_Vector x, N_Vector, SUNMatrix J, void* data,
   try {
     const Index n = eq.size();
     const double* xs = N_VGetArrayPointer(x);
+    eq.factor_next();
     if (!eq.evaluate(t, xs, xs + n)) return 1;
     return eq.jacobian(t, xs, xs + n, detail::parts(J)) ? 0 : 1;
   } catch (...) {
