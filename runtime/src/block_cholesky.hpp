@@ -1,21 +1,23 @@
-// Cholesky factors of a mass matrix that splits into independent blocks (internal to
-// simulation.cpp, which factors M at every evaluation of the accelerations).
+// Cholesky factors of a mass matrix that splits into independent blocks, and solves with them
+// (internal to simulation.cpp, which solves with M at every evaluation of the accelerations).
 //
 // Where the nonzeros of M's lower triangle fall into k groups of coordinates that share none,
 // M is block diagonal after a symmetric permutation, and its Cholesky factor is too: k small
 // factorizations replace one of order n. This is exact, not an approximation: the groups are
 // those of the matrix at hand (an entry is in no block only when it is exactly zero), judged at
 // every factorization (a check of the zeros outside the blocks, and the groups again where one is
-// not zero). Bodies in absolute coordinates joined by springs or ligaments give such an M: the
-// middle ear's is three blocks of 6 (malleus, incus, stapes), a sixth of the work of its 18×18.
+// not zero; blocks only ever merge). Bodies in absolute coordinates joined by springs or
+// ligaments give such an M: the middle ear's is three blocks of 6 (malleus, incus, stapes), a
+// ninth of the work of its 18×18.
 //
 // Most evaluations then need no factorization at all: M changes little from one evaluation to
 // the next (the middle ear's by 1e-5 of itself over a run), and solve_refined() solves with the
 // inverses of the last factored M's blocks as the approximate solver of iterative refinement in
-// working precision, until the componentwise backward error is that of a backward-stable solve
-// (the stopping rule of LAPACK's xPORFS; Higham, Accuracy and Stability of Numerical Algorithms,
-// 2nd ed., Ch. 12). Where it does not converge fast (M moved too far from the factored one), the
-// caller factors M afresh.
+// working precision, until the componentwise backward error (LAPACK xPORFS's measure; Higham,
+// Accuracy and Stability of Numerical Algorithms, 2nd ed., Ch. 12) is 4·(block size)·ε, that of
+// a backward-stable solve. Where it does not get there fast (M moved too far from the factored
+// one), the caller factors M afresh. The singularity of M is the caller's to judge, on fresh
+// factors: a refined solve proves M near the factored one only along its right-hand side.
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -38,12 +40,13 @@ class BlockCholesky {
   /// x = −M⁻¹ b, after a successful compute() (x and b may not alias).
   void solve_negated(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   /// x = −M⁻¹ b for an M near the last one compute() factored, by iterative refinement on that
-  /// one's inverse (blocks of up to 8 coordinates; M's nonzeros within the same blocks). False,
-  /// with x undefined, where that does not apply or does not reach a componentwise backward error
-  /// of 4·(block size)·ε within five corrections, each at least a hundredfold after the first
-  /// (M too far from the factored one, or non-finite): then compute() M itself.
+  /// one's inverse (all blocks of up to 8 coordinates; M's nonzeros within the same blocks;
+  /// the lower triangle read, as compute() reads it). False, with x undefined, where that does
+  /// not apply or does not reach a componentwise backward error of 4·(block size)·ε within five
+  /// corrections (the first gaining a hundredfold, each later one halving it): M too far from
+  /// the factored one, or not finite. Then compute() M itself.
   bool solve_refined(const Eigen::MatrixXd& M, const Eigen::VectorXd& b, Eigen::VectorXd& x);
-  /// How many blocks the last compute() found (1: M is dense, factored whole).
+  /// How many blocks the last compute() found (1 for a dense or empty M).
   std::size_t blocks() const { return blocks_.size(); }
 
  private:
@@ -69,7 +72,9 @@ class BlockCholesky {
   std::vector<int> block_of_;                        // each coordinate's block
   std::vector<Eigen::Index> outside_;                // M's lower entries between blocks (column-major)
   std::vector<Factors> factors_;
-  bool whole_ = false;  // one dynamic block of all coordinates: M factored in place
+  bool whole_ = false;      // one dynamic block of all coordinates: M factored in place
+  bool refinable_ = false;  // every block of fixed size (with an inverse)
+  bool factored_ = false;   // the last compute() succeeded
   Eigen::VectorXd diagonal_;
 };
 

@@ -166,14 +166,19 @@ class Equations : public detail::SecondOrderSystem {
   }
   void start_segment(double t) { segment_start_ = t; }
   // M, k − q and ÿ at (y, ẏ, u(t)); false (with the reason kept) when a kernel fails or M is
-  // singular there.
+  // singular. ÿ by refinement on the last Cholesky factors where M is near them (to the backward
+  // error of a stable solve: block_cholesky.hpp), else from M's own factors, whose singularity is
+  // judged (factor_mass()): at the Jacobian's state (factor_next()), where refinement does not
+  // converge fast, and at least every kRefinedEvaluations evaluations.
   // `signal_values`: with the signals' own values at t (a sample's, which it stores), not those
   // just after a restart at t.
   bool evaluate(double t, const double* y, const double* yd, bool signal_values = false) {
     if (signal_values) inputs_at(t); else inputs(t);
     if (!kernels(t, y, yd)) return false;
-    const bool refined = cholesky_ && !factor_next_ && cholesky_factors_.solve_refined(M_, r_, a_);
+    const bool refined = cholesky_ && !factor_next_ && refined_ < kRefinedEvaluations &&
+                         cholesky_factors_.solve_refined(M_, r_, a_);
     factor_next_ = false;
+    refined_ = refined ? refined_ + 1 : 0;
     if (!refined) {
       if (!factor_mass()) return fail(t, Failure::singular_mass);
       if (cholesky_) {  // ÿ = −M⁻¹ (k − q)
@@ -332,6 +337,11 @@ class Equations : public detail::SecondOrderSystem {
   Eigen::PartialPivLU<MatrixXd> lu_;
   bool cholesky_ = false;  // the last factor_mass() kept cholesky_factors_
   bool factor_next_ = false;  // factor_next()
+  // Evaluations since M's singularity was last judged: refined solves in a row, at most
+  // kRefinedEvaluations (every CVODE evaluation between two Jacobians, or Adams without one,
+  // could refine). A fresh factorization costs about four refined solves in the middle ear.
+  static constexpr int kRefinedEvaluations = 64;
+  int refined_ = 0;
   bool symmetry_known_ = false, symmetric_ = false;  // of M (factor_mass())
   double rcond_ = 0, segment_start_ = 0;
 };

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -79,6 +80,15 @@ TEST(BlockCholesky, ACouplingEntryMergesTheBlocks) {
   ASSERT_TRUE(factors.compute(M));
   EXPECT_EQ(factors.blocks(), 2U);
   expect_same_solution(factors, M);
+  // Blocks only merge: the coupling entry at zero again (sin 0 at one state) keeps them merged,
+  // rather than splitting and merging them again along a run.
+  MatrixXd apart = block_diagonal(owner, 3);
+  ASSERT_TRUE(factors.compute(apart));
+  EXPECT_EQ(factors.blocks(), 2U);
+  apart(4, 1) = apart(1, 4) = 0.1;  // blocks 1 and 2 now share one, blocks 0 and 1 none
+  ASSERT_TRUE(factors.compute(apart));
+  EXPECT_EQ(factors.blocks(), 1U);
+  expect_same_solution(factors, apart);
   // Only the lower triangle is read, as Eigen's LLT reads it: an entry above the diagonal alone
   // couples nothing.
   MatrixXd U = block_diagonal(owner, 3);
@@ -128,7 +138,10 @@ double backward_error(const MatrixXd& M, const VectorXd& b, const VectorXd& x) {
 TEST(BlockCholesky, RefinementOnTheFactoredInverseForANearbyMatrix) {
   std::srand(13);
   const std::vector<int> owner = {0, 1, 0, 1, 2, 2, 0, 1, 0, 1, 0, 0};  // blocks of 6, 4 and 2
-  const MatrixXd M = block_diagonal(owner, 3);
+  // Scaled as the middle ear's M, whose diagonal spans kg and kg m² (3.7e-5 to 2.8e-11).
+  VectorXd d(static_cast<Index>(owner.size()));
+  for (Index i = 0; i < d.size(); ++i) d[i] = std::pow(10.0, -2.5 - 3.0 * static_cast<double>(i % 3) / 2);
+  const MatrixXd M = d.asDiagonal() * block_diagonal(owner, 3) * d.asDiagonal();
   BlockCholesky factors(M.rows());
   ASSERT_TRUE(factors.compute(M));
   // M moved by 1e-5 of itself within its blocks (the middle ear's M over a run), symmetric.
@@ -141,7 +154,10 @@ TEST(BlockCholesky, RefinementOnTheFactoredInverseForANearbyMatrix) {
   // As a backward-stable solve of `near` itself: its goal, 4 × (block size 6) × ε.
   EXPECT_LE(backward_error(near, b, x), 24 * kEpsilon);
   const VectorXd expected = -near.llt().solve(b);
-  EXPECT_LE((x - expected).norm(), 1e4 * kEpsilon * expected.norm());
+  // The scaling makes M's condition 1e6 times that of its equilibrated blocks; the solutions'
+  // components differ by 1e3 from each other, so compare each to rounding in its own units.
+  const Eigen::ArrayXd w = d.array().square();  // x_i · d_i²: the equilibrated blocks' units
+  EXPECT_LE(((x - expected).array() * w).abs().maxCoeff(), 1e4 * kEpsilon * (expected.array() * w).abs().maxCoeff());
   // The factored M's own solution is 1e-5 off: refinement moved x to near's.
   EXPECT_GT((-M.llt().solve(b) - expected).norm(), 1e-8 * expected.norm());
 
@@ -155,6 +171,14 @@ TEST(BlockCholesky, RefinementOnTheFactoredInverseForANearbyMatrix) {
   VectorXd nan = b;
   nan[3] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(factors.solve_refined(near, nan, x));
+  // Only the lower triangle is read, as compute() reads it: an upper entry off by 10 % within a
+  // block changes nothing.
+  MatrixXd upper = near;
+  upper(0, 2) *= 1.1;
+  VectorXd z(M.rows());
+  ASSERT_TRUE(factors.solve_refined(upper, b, z));
+  EXPECT_EQ(z, x);
+
   // A block of more than 8 coordinates has no inverse kept: no refinement.
   const MatrixXd R = MatrixXd::Random(10, 10);
   const MatrixXd dense = R * R.transpose() + 10 * MatrixXd::Identity(10, 10);
@@ -162,6 +186,33 @@ TEST(BlockCholesky, RefinementOnTheFactoredInverseForANearbyMatrix) {
   ASSERT_TRUE(whole.compute(dense));
   VectorXd y(10);
   EXPECT_FALSE(whole.solve_refined(dense, VectorXd::Ones(10), y));
+}
+
+// The goal is the backward error with the denominators of the solution returned, not of the
+// first iterate: a small component of y (1e-14 beside 1), 1e-6 off in the first iterate from
+// the factored block's coupling, made the first iterate's denominators a million times too large
+// (the review's case: accepted with a backward error of 5.6e-8, y₁ 1e-7 off).
+TEST(BlockCholesky, RefinementJudgesTheSolutionItReturns) {
+  MatrixXd M0(2, 2), G(2, 2);
+  M0 << 1, 1e-6, 1e-6, 1;
+  G << 1, 0, 0, 1 + 1e-5;
+  BlockCholesky factors(2);
+  ASSERT_TRUE(factors.compute(M0));
+  const VectorXd c = (VectorXd(2) << -1e-14, -(1 + 1e-5)).finished();
+  VectorXd y(2);
+  if (factors.solve_refined(G, c, y)) {  // refused: the caller factors G itself
+    EXPECT_LE(backward_error(G, c, y), 8 * kEpsilon);
+    EXPECT_NEAR(y[0], 1e-14, 1e-29);
+  }
+  // A mix of fixed and dynamic blocks (3 and 10 coordinates) is not refined.
+  std::vector<int> owner(13, 1);
+  owner[0] = owner[5] = owner[12] = 0;
+  const MatrixXd mixed = block_diagonal(owner, 2);
+  BlockCholesky both(13);
+  ASSERT_TRUE(both.compute(mixed));
+  EXPECT_EQ(both.blocks(), 2U);
+  VectorXd x(13);
+  EXPECT_FALSE(both.solve_refined(mixed, VectorXd::Ones(13), x));
 }
 
 }  // namespace
