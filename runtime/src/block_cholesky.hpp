@@ -40,7 +40,8 @@ class BlockCholesky {
   /// x = −M⁻¹ b, after a successful compute() (x and b may not alias).
   void solve_negated(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   /// x = −M⁻¹ b for an M near the last one compute() factored, by iterative refinement on that
-  /// one's inverse (all blocks of up to 8 coordinates; M's nonzeros within the same blocks;
+  /// one's inverse (all blocks of up to 8 coordinates, the largest of 4 or more: smaller ones
+  /// factor faster than they refine; M's nonzeros within the same blocks;
   /// the lower triangle read, as compute() reads it). False, with x undefined, where that does
   /// not apply or does not reach a componentwise backward error of 4·(block size)·ε within five
   /// corrections (the first gaining a hundredfold, each later one halving it): M too far from
@@ -73,7 +74,7 @@ class BlockCholesky {
   std::vector<Eigen::Index> outside_;                // M's lower entries between blocks (column-major)
   std::vector<Factors> factors_;
   bool whole_ = false;      // one dynamic block of all coordinates: M factored in place
-  bool refinable_ = false;  // every block of fixed size (with an inverse)
+  bool refinable_ = false;  // solve_refined() applies: every block of fixed size, one of 4 or more
   bool factored_ = false;   // the last compute() succeeded
   Eigen::VectorXd diagonal_;
 };

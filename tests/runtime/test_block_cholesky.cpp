@@ -191,19 +191,32 @@ TEST(BlockCholesky, RefinementOnTheFactoredInverseForANearbyMatrix) {
 // The goal is the backward error with the denominators of the solution returned, not of the
 // first iterate: a small component of y (1e-14 beside 1), 1e-6 off in the first iterate from
 // the factored block's coupling, made the first iterate's denominators a million times too large
-// (the review's case: accepted with a backward error of 5.6e-8, y₁ 1e-7 off).
+// (the review's 2×2 case, here inside a block of 4: accepted with a backward error of 5.6e-8,
+// y₁ 1e-7 off).
 TEST(BlockCholesky, RefinementJudgesTheSolutionItReturns) {
-  MatrixXd M0(2, 2), G(2, 2);
-  M0 << 1, 1e-6, 1e-6, 1;
-  G << 1, 0, 0, 1 + 1e-5;
-  BlockCholesky factors(2);
+  // One block of 4 (the smallest refined): coordinates 0 and 1 coupled by 1e-6 in the factored
+  // M0, not in G, which is M0 moved by 1e-5.
+  MatrixXd M0 = MatrixXd::Identity(4, 4), G = MatrixXd::Identity(4, 4);
+  M0(0, 1) = M0(1, 0) = 1e-6;
+  M0(2, 3) = M0(3, 2) = G(2, 3) = G(3, 2) = 0.5;  // one block of all four
+  M0(0, 2) = M0(2, 0) = G(0, 2) = G(2, 0) = 1e-20;
+  M0(1, 3) = M0(3, 1) = G(1, 3) = G(3, 1) = 1e-20;
+  G(1, 1) = 1 + 1e-5;
+  BlockCholesky factors(4);
   ASSERT_TRUE(factors.compute(M0));
-  const VectorXd c = (VectorXd(2) << -1e-14, -(1 + 1e-5)).finished();
-  VectorXd y(2);
+  ASSERT_EQ(factors.blocks(), 1U);
+  const VectorXd c = (VectorXd(4) << -1e-14, -(1 + 1e-5), -1.5, -1.5).finished();
+  VectorXd y(4);
   if (factors.solve_refined(G, c, y)) {  // refused: the caller factors G itself
-    EXPECT_LE(backward_error(G, c, y), 8 * kEpsilon);
-    EXPECT_NEAR(y[0], 1e-14, 1e-29);
+    EXPECT_LE(backward_error(G, c, y), 16 * kEpsilon);
+    const double expected = -G.llt().solve(c)[0];  // about 1e-14 − 1e-20
+    EXPECT_NEAR(y[0], expected, 1e-12 * std::abs(expected));
   }
+  // Blocks of 3 or fewer factor faster than they refine (the double pendulum's 2×2): refused.
+  BlockCholesky small(2);
+  ASSERT_TRUE(small.compute(M0.topLeftCorner(2, 2)));
+  VectorXd z(2);
+  EXPECT_FALSE(small.solve_refined(M0.topLeftCorner(2, 2), c.head(2), z));
   // A mix of fixed and dynamic blocks (3 and 10 coordinates) is not refined.
   std::vector<int> owner(13, 1);
   owner[0] = owner[5] = owner[12] = 0;
