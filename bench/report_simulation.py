@@ -75,7 +75,11 @@ def simulation_section(results, table):
            "ear's 1e-11: at ten times the tolerance it is 1e-11, 2.7e-10 and 3e-12 off itself), relative "
            "to the largest coordinate, over all samples; atol = rtol (the middle ear: "
            "rtol × 1e-9 m). Times are medians (ours of 5 runs, SciPy's of 3). `bench/simulation_timing`, "
-           "`bench/simulation_compare.py`.", ""]
+           "`bench/simulation_compare.py`. Each SciPy run is paired with our fastest run at least as accurate "
+           "(ours every half decade of rtol, so that run may be up to a half decade more accurate than "
+           "needed); the last column is our time at exactly the SciPy run's error instead, interpolated "
+           "log–log between two neighbouring runs of one of our methods whose errors bracket it (or that "
+           "fastest run, where it is faster still).", ""]
     for problem in [p for p in LABELS if any(r["problem"] == p for r in rows)]:
         out.append("**%s**" % LABELS[problem])
         out.append("")
