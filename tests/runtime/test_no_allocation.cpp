@@ -1,12 +1,14 @@
 // The per-frequency loop of FrequencyResponse does not allocate (issue 3 §1): malloc is
 // interposed in this executable and the allocations of compute() are counted for 10 and for
 // 1000 frequencies (each after a warm-up call of the same size); per-call selection work
-// allocates the same in both, so the counts must be equal.
+// allocates the same in both, so the counts must be equal. And the mass matrix's factorizations
+// and solves at every evaluation of simulate()'s accelerations (runtime/src/block_cholesky.hpp).
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
 
+#include "block_cholesky.hpp"
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "models.hpp"
 
@@ -87,5 +89,41 @@ TEST(NoAllocation, PerFrequencyLoopOfEveryMethod) {
     const long a1000 = allocations_of_compute(f, w1000);
     EXPECT_EQ(a10, a1000) << to_string(meth) << (mp == &terms ? " with C_a, D" : "")
                           << ": the loop over frequencies allocates";
+  }
+}
+
+// The mass matrix's solve at every evaluation of simulate()'s accelerations (block_cholesky.hpp):
+// after the first factorization has found the blocks, factorizations (fixed-size blocks and a
+// dynamic one) and solves, refined or not, allocate nothing.
+TEST(NoAllocation, MassMatrixSolvesPerEvaluation) {
+  if (!MBSGEN_COUNT_ALLOCATIONS) GTEST_SKIP() << "malloc is AddressSanitizer's: not counted";
+  for (const int dynamic : {0, 10}) {  // blocks of 6, 6 and 2; and of 6 and 10 (not refined)
+    const Eigen::Index n = 14;
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+    auto block = [&M](Eigen::Index at, Eigen::Index size) {
+      const Eigen::MatrixXd R = Eigen::MatrixXd::Random(size, size);
+      M.block(at, at, size, size) = R * R.transpose() + static_cast<double>(size) * Eigen::MatrixXd::Identity(size, size);
+    };
+    if (dynamic) {
+      block(0, 4), block(4, 10);
+    } else {
+      block(0, 6), block(6, 6), block(12, 2);
+    }
+    const Eigen::MatrixXd near = M * (1 + 1e-7);
+    const Eigen::VectorXd b = Eigen::VectorXd::Random(n);
+    Eigen::VectorXd x(n);
+    mbsgen::detail::BlockCholesky factors(n);
+    ASSERT_TRUE(factors.compute(M));  // finds the blocks
+    factors.solve_negated(b, x);
+    EXPECT_EQ(factors.solve_refined(near, b, x), !dynamic);
+    g_allocations = 0;
+    g_counting = true;
+    for (int k = 0; k < 100; ++k) {
+      factors.compute(M);
+      factors.solve_negated(b, x);
+      factors.solve_refined(near, b, x);
+    }
+    g_counting = false;
+    EXPECT_EQ(g_allocations.load(), 0) << (dynamic ? "with a dynamic block" : "fixed-size blocks");
   }
 }
