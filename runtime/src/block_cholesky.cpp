@@ -22,6 +22,14 @@ constexpr int kCorrections = 5;  // LAPACK xPORFS's ITMAX
 
 std::size_t at(Index i) { return static_cast<std::size_t>(i); }
 
+// G's lower triangle := that of M's block on the coordinates `index` (ascending, so M's lower
+// triangle: what compute() factors and solve_refined() refines).
+template <class Block>
+void gather_lower(const MatrixXd& M, const std::vector<Index>& index, Block& G) {
+  for (Index c = 0; c < G.cols(); ++c)
+    for (Index r = c; r < G.rows(); ++r) G(r, c) = M(index[at(r)], index[at(c)]);
+}
+
 }  // namespace
 
 BlockCholesky::BlockCholesky(Index n) : n_(n), block_of_(at(n), 0), diagonal_(n) {}
@@ -118,14 +126,12 @@ bool BlockCholesky::compute(const MatrixXd& M) {
         [&](auto& f) {
           using F = std::decay_t<decltype(f)>;
           if constexpr (std::is_same_v<F, Dynamic>) {
-            for (Index c = 0; c < f.gathered.cols(); ++c)
-              for (Index r = c; r < f.gathered.rows(); ++r) f.gathered(r, c) = M(index[at(r)], index[at(c)]);
+            gather_lower(M, index, f.gathered);
             f.llt.compute(f.gathered);
           } else {
             using Matrix = typename std::decay_t<decltype(f.llt)>::MatrixType;
             Matrix G = Matrix::Zero();  // the lower triangle is read (and the whole copied)
-            for (Index c = 0; c < G.cols(); ++c)
-              for (Index r = c; r < G.rows(); ++r) G(r, c) = M(index[at(r)], index[at(c)]);
+            gather_lower(M, index, G);
             f.llt.compute(G);
             // The inverse for solve_refined(): applied in s² multiplications and additions, where
             // the triangular solves divide by the pivots in a chain (6×6: a tenth of the time).
@@ -212,11 +218,9 @@ bool BlockCholesky::solve_refined(const MatrixXd& M, const VectorXd& b, VectorXd
             using Vector = Eigen::Matrix<double, Matrix::RowsAtCompileTime, 1>;
             Matrix G = Matrix::Zero();
             Vector c = Vector::Zero(), y = Vector::Zero();
-            for (Index j = 0; j < G.cols(); ++j) {
-              c[j] = b[index[at(j)]];
-              for (Index i = 0; i < G.rows(); ++i)  // the lower triangle's matrix, as compute() reads it
-                G(i, j) = i >= j ? M(index[at(i)], index[at(j)]) : M(index[at(j)], index[at(i)]);
-            }
+            gather_lower(M, index, G);  // the symmetric matrix of the lower triangle, as factored
+            G.template triangularView<Eigen::StrictlyUpper>() = G.transpose().eval();
+            for (Index j = 0; j < c.size(); ++j) c[j] = b[index[at(j)]];
             if (!refine_block(G, f.inverse, c, y)) return false;
             for (Index i = 0; i < y.size(); ++i) x[index[at(i)]] = y[i];
             return true;

@@ -3,8 +3,10 @@
 //
 //   x' = (v, ÿ),   ÿ = −M(y)⁻¹ (k − q)(y, v, u(t)),   x = (y, v),
 //
-// with a factorization of M at each right-hand side (Cholesky's, the LU's where it fails; a
-// singular M is reported where it occurs). Three methods: Radau IIA of order 5 (ours, after
+// with a solve with M at each right-hand side (Cholesky's factors, block by block where M is
+// block diagonal, or the LU's where Cholesky fails; mostly refined on the last factors where M
+// is near them; a singular M is reported at the next fresh factorization, at most 64
+// evaluations after it occurs: docs/simulation.md). Three methods: Radau IIA of order 5 (ours, after
 // RADAU5: stiff and oscillating motion, tight tolerances), and SUNDIALS CVODE's BDF (orders 1–5,
 // for stiff models such as the middle ear) with Newton's iteration on the Jacobian
 // ∂x'/∂x = [0, I; −M⁻¹ K_y, −M⁻¹ K_v] from the generated kernel `dynamics_jacobian`
