@@ -20,7 +20,6 @@ using Eigen::VectorXd;
 using complex = std::complex<double>;
 
 constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
-constexpr int kNewtonIterations = 7;  // RADAU5's NIT
 constexpr double kKeepJacobian = 1e-3;  // RADAU5's THET: a Newton rate below it keeps the Jacobian
 constexpr double kSafety = 0.9;
 // A Newton iteration on a fresh Jacobian that stops contracting with corrections below this (in
@@ -31,59 +30,26 @@ constexpr double kSafety = 0.9;
 constexpr double kStalled = 0.1;
 constexpr double kMaxGrowth = 10, kMinShrink = 0.2;  // per step
 
-const double kSqrt6 = std::sqrt(6.0);
-// The nodes, and the error estimate's weights (Hairer and Wanner IV.8, (8.20)).
-const double kC[3] = {(4 - kSqrt6) / 10, (4 + kSqrt6) / 10, 1};
-const double kE[3] = {(-13 - 7 * kSqrt6) / 3, (-13 + 7 * kSqrt6) / 3, -1.0 / 3};
-
-// The Butcher matrix A; its inverse (for the stage derivatives Ż = h⁻¹ (A⁻¹ ⊗ I) Z) and
-// T⁻¹A⁻¹T = [μ_r, 0, 0; 0, α, β; 0, −β, α], μ_c = α − iβ, with RADAU5's T.
-Matrix3d butcher() {
-  Matrix3d A;
-  A << (88 - 7 * kSqrt6) / 360, (296 - 169 * kSqrt6) / 1800, (-2 + 3 * kSqrt6) / 225,  //
-      (296 + 169 * kSqrt6) / 1800, (88 + 7 * kSqrt6) / 360, (-2 - 3 * kSqrt6) / 225,   //
-      (16 - kSqrt6) / 36, (16 + kSqrt6) / 36, 1.0 / 9;
-  return A;
-}
-const Matrix3d kAinv = butcher().inverse();
-const double kMuReal = 3 + std::cbrt(9.0) - std::cbrt(3.0);
-const complex kMuComplex(3 + 0.5 * (std::cbrt(3.0) - std::cbrt(9.0)), -0.5 * (std::pow(3.0, 5.0 / 6) + std::pow(3.0, 7.0 / 6)));
-Matrix3d transformation() {
-  Matrix3d T;
-  T << 0.09443876248897524, -0.14125529502095421, 0.03002919410514742,  //
-      0.25021312296533332, 0.20412935229379994, -0.38294211275726192,    //
-      1, 1, 0;
-  return T;
-}
-const Matrix3d kT = transformation();
-const Matrix3d kTinv = kT.inverse();
-// The collocation polynomial: x(t_old + s h) = x_old + (Z P) (s, s², s³)ᵀ.
-Matrix3d dense_output() {
-  Matrix3d P;
-  P << 13.0 / 3 + 7 * kSqrt6 / 3, -23.0 / 3 - 22 * kSqrt6 / 3, 10.0 / 3 + 5 * kSqrt6,  //
-      13.0 / 3 - 7 * kSqrt6 / 3, -23.0 / 3 + 22 * kSqrt6 / 3, 10.0 / 3 - 5 * kSqrt6,   //
-      1.0 / 3, -8.0 / 3, 10.0 / 3;
-  return P;
-}
-const Matrix3d kP = dense_output();
-
 // The step-size factor of the predictive controller (Gustafsson), from this step's error and
-// the last accepted one's (none: h_old = 0).
-double predicted_factor(double h, double h_old, double error, double error_old) {
+// the last accepted one's (none: h_old = 0); the error estimate is O(h^(s+1)).
+double predicted_factor(double h, double h_old, double error, double error_old, double exponent) {
   double multiplier = 1;
-  if (h_old > 0 && error > 0 && error_old > 0) multiplier = h / h_old * std::pow(error_old / error, 0.25);
-  return error == 0 ? kMaxGrowth : std::min(1.0, multiplier) * std::pow(error, -0.25);
+  if (h_old > 0 && error > 0 && error_old > 0) multiplier = h / h_old * std::pow(error_old / error, exponent);
+  return error == 0 ? kMaxGrowth : std::min(1.0, multiplier) * std::pow(error, -exponent);
 }
 
 }  // namespace
 
-Radau::Radau(SecondOrderSystem& system, Index n, double rtol, const VectorXd& atol)
-    : system_(system), n_(n), rtol_(rtol), atol_(atol),
+Radau::Radau(SecondOrderSystem& system, Index n, double rtol, const VectorXd& atol, int stages)
+    : system_(system), tableau_(RadauTableau::of(stages)), s_(stages),
+      newton_iterations_(stages == 3 ? 7 : 7 + 3 * (stages - 3) / 2), exponent_(1.0 / (stages + 1)), n_(n),
+      rtol_(rtol), atol_(atol),
       newton_tol_(std::max(10 * kEpsilon / rtol, std::min(0.03, std::sqrt(rtol)))), x_(2 * n), x_old_(2 * n),
-      f0_(2 * n), scale_(2 * n), Z_(2 * n, 3), W_(2 * n, 3), Q_(2 * n, 3), MJ_(n, n), Ky_(n, n), Kv_(n, n),
-      equilibrate_(n), lu_real_(n), lu_complex_(n), G_(2 * n, 3), dW_(2 * n, 3), stage_(2 * n, 3), R_(n, n),
+      f0_(2 * n), scale_(2 * n), Z_(2 * n, stages), W_(2 * n, stages), Q_(2 * n, stages), MJ_(n, n), Ky_(n, n), Kv_(n, n),
+      equilibrate_(n), lu_real_(n), lu_complex_((stages - 1) / 2, Eigen::PartialPivLU<Eigen::MatrixXcd>(n)),
+      sigma_complex_((stages - 1) / 2), G_(2 * n, stages), dW_(2 * n, stages), stage_(2 * n, stages), R_(n, n),
       Rc_(n, n), x_new_(2 * n), b_(2 * n), e_(2 * n), f_(2 * n), ze_(2 * n), a_(n), work_re_(n), work_im_(n),
-      bc_(n), yc_(n) {}
+      bc_(n), yc_(n), powers_(stages), scaled_(stages, stages), e_scaled_(stages) {}
 
 // ẋ = f(t, x) = (v, ÿ(t, y, v)).
 bool Radau::derivative(double t, const VectorXd& x, VectorXd& f) {
@@ -151,27 +117,31 @@ bool Radau::evaluate_jacobian(double t, const VectorXd& x) {
 
 // The LUs of the Schur complements σ²M + σK_v + K_y for σ = μ_r/h and μ_c/h, equilibrated as
 // M is; false when one is singular to working precision.
+template <class Matrix>
+void Radau::equilibrate(Matrix& R) const {
+  for (Index j = 0; j < n_; ++j)
+    for (Index i = 0; i < n_; ++i) R(i, j) *= equilibrate_[i] * equilibrate_[j];
+}
+
 bool Radau::factor(double h) {
   ++stats_.factorizations;
-  sigma_real_ = kMuReal / h;
-  sigma_complex_ = kMuComplex / h;
-  R_ = sigma_real_ * sigma_real_ * MJ_ + sigma_real_ * Kv_ + Ky_;
-  Rc_ = (sigma_complex_ * sigma_complex_) * MJ_.cast<complex>() + sigma_complex_ * Kv_.cast<complex>() +
-        Ky_.cast<complex>();
-  for (Index j = 0; j < n_; ++j)
-    for (Index i = 0; i < n_; ++i) {
-      const double s = equilibrate_[i] * equilibrate_[j];
-      R_(i, j) *= s;
-      Rc_(i, j) *= s;
-    }
-  lu_real_.compute(R_);
-  lu_complex_.compute(Rc_);
   auto pivots_ok = [this](const auto& lu) {
     const auto d = lu.matrixLU().diagonal().cwiseAbs();
     const double largest = d.maxCoeff(), smallest = d.minCoeff();
     return std::isfinite(largest) && smallest > static_cast<double>(n_) * kEpsilon * largest;
   };
-  factored_ = pivots_ok(lu_real_) && pivots_ok(lu_complex_);
+  sigma_real_ = tableau_.gamma / h;
+  R_ = sigma_real_ * sigma_real_ * MJ_ + sigma_real_ * Kv_ + Ky_;
+  equilibrate(R_);
+  lu_real_.compute(R_);
+  factored_ = pivots_ok(lu_real_);
+  for (std::size_t k = 0; k < lu_complex_.size(); ++k) {
+    const complex sigma = sigma_complex_[k] = tableau_.mu[k] / h;
+    Rc_ = (sigma * sigma) * MJ_.cast<complex>() + sigma * Kv_.cast<complex>() + Ky_.cast<complex>();
+    equilibrate(Rc_);
+    lu_complex_[k].compute(Rc_);
+    factored_ = factored_ && pivots_ok(lu_complex_[k]);
+  }
   h_factored_ = h;
   return factored_;
 }
@@ -192,10 +162,11 @@ void Radau::solve_real(const double* b, double* out) {
   dy = (by + dv) / sigma_real_;
 }
 
-// The same for the complex σ, on b_re + i b_im.
-void Radau::solve_complex(const double* b_re, const double* b_im, double* out_re, double* out_im) {
+// The same for the k-th complex σ, on b_re + i b_im.
+void Radau::solve_complex(std::size_t k, const double* b_re, const double* b_im, double* out_re, double* out_im) {
   Eigen::Map<const VectorXd> yr(b_re, n_), vr(b_re + n_, n_), yi(b_im, n_), vi(b_im + n_, n_);
-  const double sr = sigma_complex_.real(), si = sigma_complex_.imag();
+  const complex sigma = sigma_complex_[k];
+  const double sr = sigma.real(), si = sigma.imag();
   work_re_.noalias() = MJ_ * vr;
   work_im_.noalias() = MJ_ * vi;
   bc_.real() = sr * work_re_ - si * work_im_;
@@ -205,13 +176,13 @@ void Radau::solve_complex(const double* b_re, const double* b_im, double* out_re
   bc_.real() -= work_re_;
   bc_.imag() -= work_im_;
   bc_.array() *= equilibrate_.array().cast<complex>();
-  yc_ = lu_complex_.solve(bc_);
+  yc_ = lu_complex_[k].solve(bc_);
   yc_.array() *= equilibrate_.array().cast<complex>();
   Eigen::Map<VectorXd>(out_re + n_, n_) = yc_.real();
   Eigen::Map<VectorXd>(out_im + n_, n_) = yc_.imag();
   bc_.real() = yr + yc_.real();
   bc_.imag() = yi + yc_.imag();
-  bc_ /= sigma_complex_;
+  bc_ /= sigma;
   Eigen::Map<VectorXd>(out_re, n_) = bc_.real();
   Eigen::Map<VectorXd>(out_im, n_) = bc_.imag();
 }
@@ -224,10 +195,11 @@ void Radau::solve_complex(const double* b_re, const double* b_im, double* out_re
 // that barely moves, held to its own small tolerance, then made Newton's iteration converge
 // slowly (two to three iterations more per step, and a Jacobian at most steps).
 bool Radau::residuals(double h) {
-  G_.noalias() = Z_ * (kAinv.transpose() / h);  // Ż
-  for (int i = 0; i < 3; ++i) {
+  scaled_ = tableau_.A_inv.transpose() / h;
+  G_.noalias() = Z_.lazyProduct(scaled_);  // Ż
+  for (int i = 0; i < s_; ++i) {
     b_ = x_ + Z_.col(i);
-    if (!derivative(t_ + kC[i] * h, b_, f_)) return false;
+    if (!derivative(t_ + tableau_.c[i] * h, b_, f_)) return false;
     G_.col(i) -= f_;
   }
   return true;
@@ -238,30 +210,33 @@ bool Radau::residuals(double h) {
 // first iteration accepted when the last step's rate says it has converged). False when it
 // diverges, is too slow, or an evaluation fails.
 bool Radau::newton(double h, int& iterations, double& theta) {
-  W_.noalias() = Z_ * kTinv.transpose();
+  W_.noalias() = Z_.lazyProduct(tableau_.T_inv.transpose());
   double norm_old = 0, ratio_old = 0;
   theta = kKeepJacobian;
   faccon_ = std::pow(std::max(faccon_, kEpsilon), 0.8);
-  for (int k = 1; k <= kNewtonIterations; ++k) {
+  for (int k = 1; k <= newton_iterations_; ++k) {
     iterations = k;
     if (!residuals(h)) return false;
-    stage_.noalias() = -G_ * kTinv.transpose();
+    stage_.noalias() = -G_.lazyProduct(tableau_.T_inv.transpose());
     solve_real(stage_.col(0).data(), dW_.col(0).data());
-    solve_complex(stage_.col(1).data(), stage_.col(2).data(), dW_.col(1).data(), dW_.col(2).data());
+    for (std::size_t p = 0; p < lu_complex_.size(); ++p) {
+      const Index re = static_cast<Index>(1 + 2 * p), im = re + 1;
+      solve_complex(p, stage_.col(re).data(), stage_.col(im).data(), dW_.col(re).data(), dW_.col(im).data());
+    }
     double sum = 0;
-    for (int i = 0; i < 3; ++i) sum += (dW_.col(i).array() / scale_.array()).square().sum();
-    const double dW_norm = std::sqrt(sum / static_cast<double>(3 * 2 * n_));
+    for (int i = 0; i < s_; ++i) sum += (dW_.col(i).array() / scale_.array()).square().sum();
+    const double dW_norm = std::sqrt(sum / static_cast<double>(s_ * 2 * n_));
     if (!std::isfinite(dW_norm)) return false;
     if (k > 1) {
       const double ratio = dW_norm / norm_old;
       theta = k == 2 ? ratio : std::sqrt(ratio * ratio_old);
       ratio_old = ratio;
       const bool slow = theta >= 0.99 || (theta / (1 - theta)) * dW_norm *
-                                                 std::pow(theta, kNewtonIterations - 1 - k) >= newton_tol_;
+                                                 std::pow(theta, newton_iterations_ - 1 - k) >= newton_tol_;
       if (slow && current_jacobian_ && dW_norm <= kStalled) {  // at the rounding in f
         if (ratio < 1) {  // the correction still helps; one that grows is not taken
           W_ += dW_;
-          Z_.noalias() = W_ * kT.transpose();
+          Z_.noalias() = W_.lazyProduct(tableau_.T.transpose());
         }
         theta = kKeepJacobian;  // no rate to judge the Jacobian by (accept())
         return true;
@@ -271,7 +246,7 @@ bool Radau::newton(double h, int& iterations, double& theta) {
     }
     norm_old = std::max(dW_norm, kEpsilon);
     W_ += dW_;
-    Z_.noalias() = W_ * kT.transpose();
+    Z_.noalias() = W_.lazyProduct(tableau_.T.transpose());
     if (faccon_ * dW_norm <= newton_tol_) return true;
   }
   return false;
@@ -281,7 +256,8 @@ bool Radau::newton(double h, int& iterations, double& theta) {
 // and again from f(x₀ + e) where the first one fails after a rejected step (Hairer and Wanner
 // IV.8, (8.19)–(8.20)). Its RMS norm in the tolerances.
 double Radau::error_norm(double h, const VectorXd& x_new, bool again) {
-  ze_.noalias() = Z_ * (Eigen::Vector3d(kE[0], kE[1], kE[2]) / h);
+  e_scaled_ = tableau_.E / h;
+  ze_.noalias() = Z_.lazyProduct(e_scaled_);
   b_ = f0_ + ze_;
   solve_real(b_.data(), e_.data());
   f_ = atol_.array() + rtol_ * x_.array().abs().max(x_new.array().abs());  // the scale
@@ -300,10 +276,9 @@ double Radau::error_norm(double h, const VectorXd& x_new, bool again) {
 bool Radau::try_step(double h, int& iterations, double& theta) {
   for (;;) {
     if (dense_) {
-      for (int i = 0; i < 3; ++i) {
-        const double s = (t_ + kC[i] * h - t_old_) / h_last_;
+      for (int i = 0; i < s_; ++i) {
         Z_.col(i) = x_old_ - x_;
-        Z_.col(i).noalias() += Q_ * Eigen::Vector3d(s, s * s, s * s * s);
+        Z_.col(i).noalias() += Q_.lazyProduct(powers((t_ + tableau_.c[i] * h - t_old_) / h_last_));
       }
     } else {
       Z_.setZero();
@@ -337,9 +312,9 @@ Radau::Status Radau::step(double t_stop) {
       rejected = true;
       continue;
     }
-    x_new_ = x_ + Z_.col(2);
+    x_new_ = x_ + Z_.col(s_ - 1);
     const double error = error_norm(h, x_new_, rejected || first_);
-    const double safety = kSafety * (2 * kNewtonIterations + 1) / (2 * kNewtonIterations + iterations);
+    const double safety = kSafety * (2 * newton_iterations_ + 1) / (2 * newton_iterations_ + iterations);
     if (!std::isfinite(error)) {  // no factor to predict from
       ++stats_.rejected;
       rejected = true;
@@ -349,7 +324,7 @@ Radau::Status Radau::step(double t_stop) {
     if (!(error <= 1)) {
       ++stats_.rejected;
       rejected = true;
-      h_ = h * std::max(kMinShrink, safety * predicted_factor(h, h_old_, error, error_old_));
+      h_ = h * std::max(kMinShrink, safety * predicted_factor(h, h_old_, error, error_old_, exponent_));
       continue;
     }
     if (!derivative(t_new, x_new_, b_)) {  // the next step's f(x₀): a step too far
@@ -371,10 +346,10 @@ bool Radau::accept(double t_new, double h, double error, double safety, int iter
   t_old_ = t_;
   t_ = t_new;
   h_last_ = h;
-  Q_.noalias() = Z_ * kP;
+  Q_.noalias() = Z_.lazyProduct(tableau_.P);
   dense_ = true;
   f0_ = b_;
-  double factor = std::min(kMaxGrowth, safety * predicted_factor(h, h_old_, error, error_old_));
+  double factor = std::min(kMaxGrowth, safety * predicted_factor(h, h_old_, error, error_old_, exponent_));
   h_old_ = h;
   error_old_ = error;
   // A Jacobian again where the iteration converged slowly (RADAU5, SciPy), unless it converged
@@ -399,11 +374,17 @@ bool Radau::accept(double t_new, double h, double error, double safety, int iter
   return !jacobian_failed_;
 }
 
+// (θ, θ², …, θ^s), for the collocation polynomial.
+const VectorXd& Radau::powers(double theta) const {
+  double p = 1;
+  for (int k = 0; k < s_; ++k) powers_[k] = p *= theta;
+  return powers_;
+}
+
 void Radau::interpolate(double t, double* x) const {
-  const double s = (t - t_old_) / h_last_;
   Eigen::Map<VectorXd> out(x, 2 * n_);
   out = x_old_;
-  out.noalias() += Q_ * Eigen::Vector3d(s, s * s, s * s * s);
+  out.noalias() += Q_.lazyProduct(powers((t - t_old_) / h_last_));
 }
 
 }  // namespace mbsgen::detail

@@ -18,7 +18,10 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "radau_tableau.hpp"
+
 #include <complex>
+#include <vector>
 
 namespace mbsgen::detail {
 
@@ -43,8 +46,9 @@ struct RadauStatistics {
 
 class Radau {
  public:
-  /// n coordinates; tolerances of x = (y, v): rtol and one atol per state (2n).
-  Radau(SecondOrderSystem& system, Eigen::Index n, double rtol, const Eigen::VectorXd& atol);
+  /// n coordinates; tolerances of x = (y, v): rtol and one atol per state (2n); 3 stages
+  /// (order 5, RADAU5) or 5 (order 9).
+  Radau(SecondOrderSystem& system, Eigen::Index n, double rtol, const Eigen::VectorXd& atol, int stages = 3);
 
   /// Starts at (t, x) without history: the start, or a restart after an input jumps. False when
   /// the equations or their Jacobian fail there.
@@ -69,14 +73,21 @@ class Radau {
   bool try_step(double h, int& iterations, double& theta);
   bool evaluate_jacobian(double t, const Eigen::VectorXd& x);
   bool factor(double h);
+  template <class Matrix>
+  void equilibrate(Matrix& R) const;  // S R S, S = diag(equilibrate_)
   void solve_real(const double* b, double* out);
-  void solve_complex(const double* b_re, const double* b_im, double* out_re, double* out_im);
+  void solve_complex(std::size_t k, const double* b_re, const double* b_im, double* out_re, double* out_im);
+  const Eigen::VectorXd& powers(double theta) const;
   bool derivative(double t, const Eigen::VectorXd& x, Eigen::VectorXd& f);
   double error_norm(double h, const Eigen::VectorXd& x_new, bool again);
   double norm(const Eigen::VectorXd& e, const Eigen::VectorXd& scale) const;
   bool accept(double t_new, double h, double error, double safety, int iterations, double theta);
 
   SecondOrderSystem& system_;
+  const RadauTableau& tableau_;
+  int s_;                 // stages
+  int newton_iterations_;  // RADAU5's NIT: 7 for 3 stages, 10 for 5
+  double exponent_;       // the step-size controller's, 1/(s + 1)
   Eigen::Index n_;
   double rtol_;
   Eigen::VectorXd atol_;
@@ -92,13 +103,13 @@ class Radau {
   double faccon_ = 1;          // RADAU5's FACCON: θ/(1 − θ) of the last Newton iteration
   double h_factored_ = 0;
   Eigen::VectorXd x_, x_old_, f0_, scale_;  // f0_: ẋ at the step's start
-  Eigen::MatrixXd Z_, W_, Q_;  // 2n × 3: stage increments, transformed, dense output
+  Eigen::MatrixXd Z_, W_, Q_;  // 2n × s: stage increments, transformed, dense output
   Eigen::MatrixXd MJ_, Ky_, Kv_;
   Eigen::VectorXd equilibrate_;  // S = diag(|M_ii|)^(-1/2) of MJ
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_real_;
-  Eigen::PartialPivLU<Eigen::MatrixXcd> lu_complex_;
+  std::vector<Eigen::PartialPivLU<Eigen::MatrixXcd>> lu_complex_;  // one per complex pair
   double sigma_real_ = 0;
-  std::complex<double> sigma_complex_;
+  std::vector<std::complex<double>> sigma_complex_;
   // Work space.
   Eigen::MatrixXd G_, dW_, stage_;
   Eigen::MatrixXd R_;
@@ -106,6 +117,9 @@ class Radau {
   Eigen::VectorXd x_new_;
   Eigen::VectorXd b_, e_, f_, ze_, a_, work_re_, work_im_;
   Eigen::VectorXcd bc_, yc_;
+  mutable Eigen::VectorXd powers_;
+  Eigen::MatrixXd scaled_;    // A⁻ᵀ/h
+  Eigen::VectorXd e_scaled_;  // E/h
   RadauStatistics stats_;
 };
 

@@ -32,6 +32,7 @@ SimulationOptions simulation_options(const GeneratedModel& model, const Simulate
   s.difference_quotients = o.difference_quotients;
   s.method = o.method == "adams"   ? IntegrationMethod::adams
              : o.method == "radau" ? IntegrationMethod::radau
+             : o.method == "radau9" ? IntegrationMethod::radau9
                                    : IntegrationMethod::bdf;
   for (const std::string& a : o.initial) {
     const auto [name, text] = assignment(a, "--initial");
@@ -170,8 +171,10 @@ CLI::App* add_simulate(CLI::App& app, SimulateOptions& o) {
   s->add_option("--atol-of", o.atol_of, "the absolute tolerance of one coordinate or rate, NAME=VALUE or "
                                         "NAME_dot=VALUE, in its units (states of different sizes); repeatable");
   s->add_option("--method", o.method, "bdf (stiff models; the default), radau (Radau IIA of order 5: stiff and "
-                                     "oscillating models, tighter tolerances) or adams (non-stiff motion: fewer, "
-                                     "more accurate steps)")->check(CLI::IsMember({"bdf", "radau", "adams"}));
+                                     "oscillating models, tighter tolerances), radau9 (Radau IIA of order 9: the "
+                                     "same, fewer and longer steps on smooth motion) or adams (non-stiff motion: "
+                                     "fewer, more accurate steps)")
+      ->check(CLI::IsMember({"bdf", "radau", "radau9", "adams"}));
   s->add_option("--format", o.format, "output format")->check(CLI::IsMember({"csv", "json"}));
   s->add_option("--plot", o.plot, "plot chosen series against time (FILE.svg or FILE.png)");
   s->add_option("--show", o.show, "the series to plot (default: the outputs); repeatable");

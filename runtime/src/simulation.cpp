@@ -443,8 +443,10 @@ void check_options(const GeneratedModel& model, const SimulationOptions& o) {
   positive(o.duration, "the duration");
   positive(o.step, "the output step");
   positive(o.rtol, "rtol");
-  if (o.method == IntegrationMethod::radau && o.rtol < 100 * std::numeric_limits<double>::epsilon())
-    throw Error("simulate: --method radau needs rtol of at least 100 ε = 2.2e-14 (its Newton iteration stops at "
+  const bool radau = o.method == IntegrationMethod::radau || o.method == IntegrationMethod::radau9;
+  if (radau && o.rtol < 100 * std::numeric_limits<double>::epsilon())
+    throw Error(std::string("simulate: --method ") + (o.method == IntegrationMethod::radau ? "radau" : "radau9") +
+                " needs rtol of at least 100 ε = 2.2e-14 (its Newton iteration stops at "
                 "10 ε / rtol of the tolerance), got " + std::to_string(o.rtol));
   positive(o.atol, "atol");
   absolute_tolerances(k, o);  // the names and values of atol_of
@@ -701,7 +703,7 @@ class CvodeIntegrator : public Integrator {
 class RadauIntegrator : public Integrator {
  public:
   RadauIntegrator(Equations& eq, const SimulationOptions& o, const VectorXd& x0)
-      : eq_(eq), radau_(eq, eq.size(), o.rtol, absolute_tolerances(eq.kernels(), o)) {
+      : eq_(eq), radau_(eq, eq.size(), o.rtol, absolute_tolerances(eq.kernels(), o), o.method == IntegrationMethod::radau9 ? 5 : 3) {
     start(0, x0);
   }
   double step(double, double stop) override {
@@ -833,7 +835,7 @@ SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op,
   if (!eq.evaluate(0.0, y.data(), yd.data()))
     throw SimulationError("simulate: the initial state fails " + at_time(0) + ": " + eq.reason(), 0.0);
   std::unique_ptr<Integrator> in;
-  if (o.method == IntegrationMethod::radau)
+  if (o.method == IntegrationMethod::radau || o.method == IntegrationMethod::radau9)
     in = std::make_unique<RadauIntegrator>(eq, o, x0);
   else
     in = std::make_unique<CvodeIntegrator>(eq, o, x0);

@@ -63,17 +63,20 @@ std::vector<double> zero_crossings(const SimulationResult& r, Eigen::Index i) {
 }
 
 const char* method_name(mbsgen::IntegrationMethod m) {
-  return m == mbsgen::IntegrationMethod::bdf ? "bdf" : m == mbsgen::IntegrationMethod::radau ? "radau" : "adams";
+  return m == mbsgen::IntegrationMethod::bdf      ? "bdf"
+         : m == mbsgen::IntegrationMethod::radau  ? "radau"
+         : m == mbsgen::IntegrationMethod::radau9 ? "radau9"
+                                                  : "adams";
 }
 
 // The period of the simple pendulum at amplitude θ0: T = 4 √(l/g) K(sin(θ0/2)) (the complete
 // elliptic integral of the first kind of modulus k; e.g. Landau & Lifshitz, Mechanics, §11,
-// problem 1), against the zero crossings of φ over ten periods (Adams and Radau, rtol 1e-12; the
-// crossings between samples of 1 ms from their interpolants): to 1e-9.
+// problem 1), against the zero crossings of φ over ten periods (Adams and Radau of orders 5 and
+// 9, rtol 1e-12; the crossings between samples of 1 ms from their interpolants): to 1e-9.
 TEST(Simulation, SimplePendulumPeriodAtLargeAmplitudeMatchesTheEllipticIntegral) {
   GeneratedModel model(simple_pendulum::kernels());
   const double l = 1.0, g = 9.81;
-  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::radau})
+  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::radau, mbsgen::IntegrationMethod::radau9})
   for (double theta0 : {0.1, 1.0, 2.5, 3.0}) {
     const double T = 4 * std::sqrt(l / g) * std::comp_ellint_1(std::sin(theta0 / 2));
     SimulationOptions o;
@@ -136,7 +139,8 @@ TEST(Simulation, DoublePendulumConservesEnergyOver100Periods) {
 // Jacobian kernel and on difference quotients alike.
 TEST(Simulation, DoublePendulumEnergyDriftFallsWithTheTolerance) {
   GeneratedModel model(double_pendulum::kernels());
-  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::bdf, mbsgen::IntegrationMethod::radau})
+  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::bdf, mbsgen::IntegrationMethod::radau,
+                      mbsgen::IntegrationMethod::radau9})
     for (const auto& [p1, p2] : std::vector<std::pair<double, double>>{{0.3, -0.2}, {1.5, 2.0}}) {
       const double coarse = energy_drift(model, method, p1, p2, 1e-9), fine = energy_drift(model, method, p1, p2, 1e-11);
       EXPECT_LT(fine, coarse / 10) << method_name(method) << " from " << p1
@@ -256,7 +260,8 @@ TEST(Simulation, LinearRotorStepResponseMatchesTheMatrixExponential) {
   };
   for (const Case c : {Case{mbsgen::IntegrationMethod::bdf, false}, Case{mbsgen::IntegrationMethod::bdf, true},
                        Case{mbsgen::IntegrationMethod::adams, false}, Case{mbsgen::IntegrationMethod::radau, false},
-                       Case{mbsgen::IntegrationMethod::radau, true}}) {
+                       Case{mbsgen::IntegrationMethod::radau, true}, Case{mbsgen::IntegrationMethod::radau9, false},
+                       Case{mbsgen::IntegrationMethod::radau9, true}}) {
     double error[2] = {};
     for (int tight = 0; tight < 2; ++tight) {
       SimulationOptions o;
@@ -267,7 +272,7 @@ TEST(Simulation, LinearRotorStepResponseMatchesTheMatrixExponential) {
       // Radau is 100 times as accurate at each tolerance: at 1e-9 it is within 7e-11 of itself at
       // 1e-11, below the error of the eigendecomposition behind `exact` (3e-10 at t = 4 s), so
       // it is compared at 1e-6 and 1e-8.
-      const bool radau = c.method == mbsgen::IntegrationMethod::radau;
+      const bool radau = c.method == mbsgen::IntegrationMethod::radau || c.method == mbsgen::IntegrationMethod::radau9;
       o.rtol = tight ? (radau ? 1e-8 : 1e-11) : (radau ? 1e-6 : 1e-9);
       o.atol = o.rtol * 1e-7;  // the response is 5e-6 m and 1e-3 m/s
       o.inputs = {InputSignal::step(U, ts)};
@@ -314,7 +319,7 @@ TEST(Simulation, FailuresAreReportedWithTheTime) {
     EXPECT_NE(what.find("the mass matrix is singular"), std::string::npos) << what;
     EXPECT_EQ(t, 0.0) << what;
   }
-  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::radau}) {
+  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::radau, mbsgen::IntegrationMethod::radau9}) {
     // more steps between two samples than allowed: a fast pendulum sampled once
     GeneratedModel model(simple_pendulum::kernels());
     model.set("g", 1e7);
@@ -562,7 +567,7 @@ TEST(Simulation, FourBarSwingsWithItsLoopClosed) {
   const mbsgen::OperatingPoint op = model.operating_point();
   const double omega = std::sqrt(115.2470787951297394601), T = 2 * kPi / omega;
   // Radau too, on difference-quotient Jacobians (the loops' kernels have no dynamics_jacobian).
-  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::radau}) {
+  for (auto method : {mbsgen::IntegrationMethod::adams, mbsgen::IntegrationMethod::radau, mbsgen::IntegrationMethod::radau9}) {
     SimulationOptions o;
     o.method = method;
     o.duration = 10.2 * T;
@@ -704,11 +709,12 @@ TEST(Simulation, FourBarCrankTurnsFully) {
 TEST(Simulation, RadauMiddleEarSineAgreesWithTheFrequencyResponse) {
   GeneratedModel model(middle_ear::kernels());
   const Eigen::Index input = model.input_index("P"), output = model.output_index("v_stapes");
-  const auto radau = mbsgen::IntegrationMethod::radau;
-  const double large = std::abs(sine_against_frf(model, input, output, 1000, 2000, 10, 5, 1e-9, radau));
-  const double small = std::abs(sine_against_frf(model, input, output, 1000, 200, 10, 5, 1e-9, radau));
-  EXPECT_LT(small, 1e-5) << large << " at 2000 Pa, " << small << " at 200 Pa";
-  EXPECT_LT(small, large / 6) << large << " at 2000 Pa, " << small << " at 200 Pa";
+  for (auto radau : {mbsgen::IntegrationMethod::radau, mbsgen::IntegrationMethod::radau9}) {
+    const double large = std::abs(sine_against_frf(model, input, output, 1000, 2000, 10, 5, 1e-9, radau));
+    const double small = std::abs(sine_against_frf(model, input, output, 1000, 200, 10, 5, 1e-9, radau));
+    EXPECT_LT(small, 1e-5) << method_name(radau) << ": " << large << " at 2000 Pa, " << small << " at 200 Pa";
+    EXPECT_LT(small, large / 6) << method_name(radau) << ": " << large << " at 2000 Pa, " << small << " at 200 Pa";
+  }
 }
 
 // Radau without a first step: gravity of 1e300 m/s² (CVODE's case is in
@@ -724,6 +730,8 @@ TEST(Simulation, RadauWithoutAFirstStepSaysSo) {
   EXPECT_NE(what.find("cannot start at t = 0 s: no first step fits"), std::string::npos) << what;
   EXPECT_EQ(t, 0.0) << what;
   o.rtol = 1e-15;  // below 100 ε its Newton tolerance, 10 ε / rtol, would exceed the tolerance itself
+  EXPECT_THROW(run(model, o), mbsgen::Error);
+  o.method = mbsgen::IntegrationMethod::radau9;
   EXPECT_THROW(run(model, o), mbsgen::Error);
 }
 
