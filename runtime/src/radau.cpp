@@ -1,13 +1,18 @@
-// Radau IIA of order 5 on M(y) ÿ + r(y, ẏ, t) = 0 (radau.hpp).
+// Radau IIA of orders 5 and 9 on M(y) ÿ + r(y, ẏ, t) = 0 (radau.hpp).
 #include "radau.hpp"
 
+#include "radau_tableau.hpp"
 #include "second_order_newton.hpp"
 
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <complex>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace mbsgen::detail {
 
@@ -40,19 +45,106 @@ double predicted_factor(double h, double h_old, double error, double error_old, 
 
 }  // namespace
 
-Radau::Radau(SecondOrderSystem& system, Index n, double rtol, const VectorXd& atol, int stages)
-    : system_(system), tableau_(RadauTableau::of(stages)), s_(stages),
-      newton_iterations_(stages == 3 ? 7 : 7 + 3 * (stages - 3) / 2), exponent_(1.0 / (stages + 1)), n_(n),
-      rtol_(rtol), atol_(atol),
+// S stages, S odd: the stage matrices 2n × S and the constants of fixed size.
+template <int S>
+class RadauIIA final : public Radau {
+ public:
+  RadauIIA(SecondOrderSystem& system, Index n, double rtol, const VectorXd& atol);
+  bool start(double t, const VectorXd& x) override;
+  Status step(double t_stop) override;
+  double time() const override { return t_; }
+  const VectorXd& state() const override { return x_; }
+  double step_size() const override { return h_; }
+  void interpolate(double t, double* x) const override;
+  const RadauStatistics& statistics() const override { return stats_; }
+
+ private:
+  using Stages = Eigen::Matrix<double, Eigen::Dynamic, S>;
+  using Square = Eigen::Matrix<double, S, S>;
+  using Vector = Eigen::Matrix<double, S, 1>;
+  static constexpr std::size_t kPairs = (S - 1) / 2;  // A⁻¹'s complex eigenvalue pairs
+  // RADAU5's NIT, 7 for three stages; RADAU's for five, 10 (Newton's first iterate is further
+  // from the collocation solution over a longer step).
+  static constexpr int kNewtonIterations = S == 3 ? 7 : 10;
+  static constexpr double kExponent = 1.0 / (S + 1);  // the controller's: the estimate is O(h^(S+1))
+
+  bool newton(double h, int& iterations, double& theta);
+  bool residuals(double h);
+  bool try_step(double h, int& iterations, double& theta);
+  bool evaluate_jacobian(double t, const VectorXd& x);
+  bool factor(double h);
+  template <class Matrix>
+  void equilibrate(Matrix& R) const;  // S R S, S = diag(equilibrate_)
+  void solve_real(const double* b, double* out);
+  void solve_complex(std::size_t k, const double* b_re, const double* b_im, double* out_re, double* out_im);
+  static Vector powers(double theta);  // (θ, θ², …, θ^S)
+  bool derivative(double t, const VectorXd& x, VectorXd& f);
+  double error_norm(double h, const VectorXd& x_new, bool again);
+  double norm(const VectorXd& e, const VectorXd& scale);
+  bool accept(double t_new, double h, double error, double safety, int iterations, double theta);
+
+  SecondOrderSystem& system_;
+  Index n_;
+  double rtol_;
+  VectorXd atol_;
+  double newton_tol_;
+  // The tableau (radau_tableau.hpp): nodes, (A⁻¹)ᵀ, T⁻ᵀ, Tᵀ, dense output, error weights.
+  Vector c_, E_;
+  Square A_invT_, T_invT_, T_T_, P_;
+  double gamma_ = 0;
+  std::array<complex, kPairs> mu_;
+
+  double t_ = 0, h_ = 0, h_old_ = 0, error_old_ = 0, t_old_ = 0, h_last_ = 0, h_unclamped_ = 0;
+  bool dense_ = false;         // a previous step's polynomial to start Newton from
+  bool first_ = true;          // no step accepted since start()
+  bool current_jacobian_ = false;
+  bool jacobian_failed_ = false;
+  bool factored_ = false;
+  double fresh_theta_ = 0;   // θ of the last step's Newton iteration on a fresh Jacobian
+  double faccon_ = 1;          // RADAU5's FACCON: θ/(1 − θ) of the last Newton iteration
+  double h_factored_ = 0;
+  VectorXd x_, x_old_, f0_, scale_;  // f0_: ẋ at the step's start
+  Stages Z_, W_, Q_;  // stage increments, transformed, dense output
+  MatrixXd MJ_, Ky_, Kv_;
+  VectorXd equilibrate_;  // S = diag(|M_ii|)^(-1/2) of MJ
+  Eigen::PartialPivLU<MatrixXd> lu_real_;
+  std::array<Eigen::PartialPivLU<Eigen::MatrixXcd>, kPairs> lu_complex_;
+  double sigma_real_ = 0;
+  std::array<complex, kPairs> sigma_complex_;
+  // Work space.
+  Stages G_, dW_, stage_;
+  MatrixXd R_;
+  Eigen::MatrixXcd Rc_;
+  VectorXd x_new_;
+  VectorXd b_, e_, f_, ze_, a_, work_re_, work_im_, quotient_;
+  Eigen::VectorXcd bc_, yc_;
+  RadauStatistics stats_;
+};
+
+template <int S>
+RadauIIA<S>::RadauIIA(SecondOrderSystem& system, Index n, double rtol, const VectorXd& atol)
+    : system_(system), n_(n), rtol_(rtol), atol_(atol),
       newton_tol_(std::max(10 * kEpsilon / rtol, std::min(0.03, std::sqrt(rtol)))), x_(2 * n), x_old_(2 * n),
-      f0_(2 * n), scale_(2 * n), Z_(2 * n, stages), W_(2 * n, stages), Q_(2 * n, stages), MJ_(n, n), Ky_(n, n), Kv_(n, n),
-      equilibrate_(n), lu_real_(n), lu_complex_((stages - 1) / 2, Eigen::PartialPivLU<Eigen::MatrixXcd>(n)),
-      sigma_complex_((stages - 1) / 2), G_(2 * n, stages), dW_(2 * n, stages), stage_(2 * n, stages), R_(n, n),
-      Rc_(n, n), x_new_(2 * n), b_(2 * n), e_(2 * n), f_(2 * n), ze_(2 * n), a_(n), work_re_(n), work_im_(n),
-      bc_(n), yc_(n), powers_(stages), scaled_(stages, stages), e_scaled_(stages) {}
+      f0_(2 * n), scale_(2 * n), Z_(2 * n, S), W_(2 * n, S), Q_(2 * n, S), MJ_(n, n), Ky_(n, n), Kv_(n, n),
+      equilibrate_(n), lu_real_(n), G_(2 * n, S), dW_(2 * n, S), stage_(2 * n, S), R_(n, n), Rc_(n, n),
+      x_new_(2 * n), b_(2 * n), e_(2 * n), f_(2 * n), ze_(2 * n), a_(n), work_re_(n), work_im_(n), quotient_(2 * n), bc_(n), yc_(n) {
+  const RadauTableau& t = RadauTableau::of(S);
+  c_ = t.c;
+  A_invT_ = t.A_inv.transpose();
+  T_invT_ = t.T_inv.transpose();
+  T_T_ = t.T.transpose();
+  P_ = t.P;
+  E_ = t.E;
+  gamma_ = t.gamma;
+  for (std::size_t k = 0; k < kPairs; ++k) {
+    mu_[k] = t.mu[k];
+    lu_complex_[k] = Eigen::PartialPivLU<Eigen::MatrixXcd>(n);
+  }
+}
 
 // ẋ = f(t, x) = (v, ÿ(t, y, v)).
-bool Radau::derivative(double t, const VectorXd& x, VectorXd& f) {
+template <int S>
+bool RadauIIA<S>::derivative(double t, const VectorXd& x, VectorXd& f) {
   ++stats_.evaluations;
   if (!system_.accelerations(t, x.data(), x.data() + n_, a_)) return false;
   f.head(n_) = x.tail(n_);
@@ -60,11 +152,15 @@ bool Radau::derivative(double t, const VectorXd& x, VectorXd& f) {
   return f.allFinite();
 }
 
-double Radau::norm(const VectorXd& e, const VectorXd& scale) const {  // RMS, without overflow
-  return e.size() == 0 ? 0.0 : (e.array() / scale.array()).matrix().stableNorm() / std::sqrt(static_cast<double>(e.size()));
+template <int S>
+double RadauIIA<S>::norm(const VectorXd& e, const VectorXd& scale) {  // RMS, without overflow
+  if (e.size() == 0) return 0.0;
+  quotient_ = e.array() / scale.array();
+  return quotient_.stableNorm() / std::sqrt(static_cast<double>(e.size()));
 }
 
-bool Radau::start(double t, const VectorXd& x) {
+template <int S>
+bool RadauIIA<S>::start(double t, const VectorXd& x) {
   t_ = t;
   x_ = x;
   dense_ = false;
@@ -90,7 +186,8 @@ bool Radau::start(double t, const VectorXd& x) {
 
 // M, K_y, K_v at (t, x): the kernels', or difference quotients of the accelerations
 // (K_y = −M ∂ÿ/∂y, K_v = −M ∂ÿ/∂v), steps √ε · max(|x_j|, atol_j / rtol).
-bool Radau::evaluate_jacobian(double t, const VectorXd& x) {
+template <int S>
+bool RadauIIA<S>::evaluate_jacobian(double t, const VectorXd& x) {
   ++stats_.jacobians;
   current_jacobian_ = true;
   factored_ = false;
@@ -117,26 +214,28 @@ bool Radau::evaluate_jacobian(double t, const VectorXd& x) {
 
 // The LUs of the Schur complements σ²M + σK_v + K_y for σ = μ_r/h and μ_c/h, equilibrated as
 // M is; false when one is singular to working precision.
+template <int S>
 template <class Matrix>
-void Radau::equilibrate(Matrix& R) const {
+void RadauIIA<S>::equilibrate(Matrix& R) const {
   for (Index j = 0; j < n_; ++j)
     for (Index i = 0; i < n_; ++i) R(i, j) *= equilibrate_[i] * equilibrate_[j];
 }
 
-bool Radau::factor(double h) {
+template <int S>
+bool RadauIIA<S>::factor(double h) {
   ++stats_.factorizations;
   auto pivots_ok = [this](const auto& lu) {
     const auto d = lu.matrixLU().diagonal().cwiseAbs();
     const double largest = d.maxCoeff(), smallest = d.minCoeff();
     return std::isfinite(largest) && smallest > static_cast<double>(n_) * kEpsilon * largest;
   };
-  sigma_real_ = tableau_.gamma / h;
+  sigma_real_ = gamma_ / h;
   R_ = sigma_real_ * sigma_real_ * MJ_ + sigma_real_ * Kv_ + Ky_;
   equilibrate(R_);
   lu_real_.compute(R_);
   factored_ = pivots_ok(lu_real_);
-  for (std::size_t k = 0; k < lu_complex_.size(); ++k) {
-    const complex sigma = sigma_complex_[k] = tableau_.mu[k] / h;
+  for (std::size_t k = 0; k < kPairs; ++k) {
+    const complex sigma = sigma_complex_[k] = mu_[k] / h;
     Rc_ = (sigma * sigma) * MJ_.cast<complex>() + sigma * Kv_.cast<complex>() + Ky_.cast<complex>();
     equilibrate(Rc_);
     lu_complex_[k].compute(Rc_);
@@ -150,7 +249,8 @@ bool Radau::factor(double h) {
 // times M is K_y Δy + (σM + K_v) Δv = M b_v, and through Δv, (σ²M + σK_v + K_y) Δv =
 // σ M b_v − K_y b_y and Δy = (b_y + Δv)/σ (which divides Δv's rounding by σ; through Δy,
 // Δv = σΔy − b_y would multiply Δy's by σ).
-void Radau::solve_real(const double* b, double* out) {
+template <int S>
+void RadauIIA<S>::solve_real(const double* b, double* out) {
   Eigen::Map<const VectorXd> by(b, n_), bv(b + n_, n_);
   Eigen::Map<VectorXd> dy(out, n_), dv(out + n_, n_);
   VectorXd& rhs = work_re_;
@@ -163,7 +263,8 @@ void Radau::solve_real(const double* b, double* out) {
 }
 
 // The same for the k-th complex σ, on b_re + i b_im.
-void Radau::solve_complex(std::size_t k, const double* b_re, const double* b_im, double* out_re, double* out_im) {
+template <int S>
+void RadauIIA<S>::solve_complex(std::size_t k, const double* b_re, const double* b_im, double* out_re, double* out_im) {
   Eigen::Map<const VectorXd> yr(b_re, n_), vr(b_re + n_, n_), yi(b_im, n_), vi(b_im + n_, n_);
   const complex sigma = sigma_complex_[k];
   const double sr = sigma.real(), si = sigma.imag();
@@ -194,12 +295,12 @@ void Radau::solve_complex(std::size_t k, const double* b_re, const double* b_im,
 // in the middle ear at 1 Pa), the implicit form's residual no longer matches it. A rotation
 // that barely moves, held to its own small tolerance, then made Newton's iteration converge
 // slowly (two to three iterations more per step, and a Jacobian at most steps).
-bool Radau::residuals(double h) {
-  scaled_ = tableau_.A_inv.transpose() / h;
-  G_.noalias() = Z_.lazyProduct(scaled_);  // Ż
-  for (int i = 0; i < s_; ++i) {
+template <int S>
+bool RadauIIA<S>::residuals(double h) {
+  G_.noalias() = Z_ * (A_invT_ / h);  // Ż
+  for (int i = 0; i < S; ++i) {
     b_ = x_ + Z_.col(i);
-    if (!derivative(t_ + tableau_.c[i] * h, b_, f_)) return false;
+    if (!derivative(t_ + c_[i] * h, b_, f_)) return false;
     G_.col(i) -= f_;
   }
   return true;
@@ -209,34 +310,35 @@ bool Radau::residuals(double h) {
 // coordinates W = Z T⁻ᵀ (RADAU5's convergence test: the rate θ of the last iterations, and a
 // first iteration accepted when the last step's rate says it has converged). False when it
 // diverges, is too slow, or an evaluation fails.
-bool Radau::newton(double h, int& iterations, double& theta) {
-  W_.noalias() = Z_.lazyProduct(tableau_.T_inv.transpose());
+template <int S>
+bool RadauIIA<S>::newton(double h, int& iterations, double& theta) {
+  W_.noalias() = Z_ * T_invT_;
   double norm_old = 0, ratio_old = 0;
   theta = kKeepJacobian;
   faccon_ = std::pow(std::max(faccon_, kEpsilon), 0.8);
-  for (int k = 1; k <= newton_iterations_; ++k) {
+  for (int k = 1; k <= kNewtonIterations; ++k) {
     iterations = k;
     if (!residuals(h)) return false;
-    stage_.noalias() = -G_.lazyProduct(tableau_.T_inv.transpose());
+    stage_.noalias() = G_ * (-T_invT_);
     solve_real(stage_.col(0).data(), dW_.col(0).data());
-    for (std::size_t p = 0; p < lu_complex_.size(); ++p) {
+    for (std::size_t p = 0; p < kPairs; ++p) {
       const Index re = static_cast<Index>(1 + 2 * p), im = re + 1;
       solve_complex(p, stage_.col(re).data(), stage_.col(im).data(), dW_.col(re).data(), dW_.col(im).data());
     }
     double sum = 0;
-    for (int i = 0; i < s_; ++i) sum += (dW_.col(i).array() / scale_.array()).square().sum();
-    const double dW_norm = std::sqrt(sum / static_cast<double>(s_ * 2 * n_));
+    for (int i = 0; i < S; ++i) sum += (dW_.col(i).array() / scale_.array()).square().sum();
+    const double dW_norm = std::sqrt(sum / static_cast<double>(S * 2 * n_));
     if (!std::isfinite(dW_norm)) return false;
     if (k > 1) {
       const double ratio = dW_norm / norm_old;
       theta = k == 2 ? ratio : std::sqrt(ratio * ratio_old);
       ratio_old = ratio;
       const bool slow = theta >= 0.99 || (theta / (1 - theta)) * dW_norm *
-                                                 std::pow(theta, newton_iterations_ - 1 - k) >= newton_tol_;
+                                                 std::pow(theta, kNewtonIterations - 1 - k) >= newton_tol_;
       if (slow && current_jacobian_ && dW_norm <= kStalled) {  // at the rounding in f
         if (ratio < 1) {  // the correction still helps; one that grows is not taken
           W_ += dW_;
-          Z_.noalias() = W_.lazyProduct(tableau_.T.transpose());
+          Z_.noalias() = W_ * T_T_;
         }
         theta = kKeepJacobian;  // no rate to judge the Jacobian by (accept())
         return true;
@@ -246,7 +348,7 @@ bool Radau::newton(double h, int& iterations, double& theta) {
     }
     norm_old = std::max(dW_norm, kEpsilon);
     W_ += dW_;
-    Z_.noalias() = W_.lazyProduct(tableau_.T.transpose());
+    Z_.noalias() = W_ * T_T_;
     if (faccon_ * dW_norm <= newton_tol_) return true;
   }
   return false;
@@ -255,9 +357,9 @@ bool Radau::newton(double h, int& iterations, double& theta) {
 // The embedded error estimate, filtered by the real system: e = (σ_r I − J)⁻¹ (f(x₀) + Z E/h),
 // and again from f(x₀ + e) where the first one fails after a rejected step (Hairer and Wanner
 // IV.8, (8.19)–(8.20)). Its RMS norm in the tolerances.
-double Radau::error_norm(double h, const VectorXd& x_new, bool again) {
-  e_scaled_ = tableau_.E / h;
-  ze_.noalias() = Z_.lazyProduct(e_scaled_);
+template <int S>
+double RadauIIA<S>::error_norm(double h, const VectorXd& x_new, bool again) {
+  ze_.noalias() = Z_ * (E_ / h);
   b_ = f0_ + ze_;
   solve_real(b_.data(), e_.data());
   f_ = atol_.array() + rtol_ * x_.array().abs().max(x_new.array().abs());  // the scale
@@ -273,12 +375,13 @@ double Radau::error_norm(double h, const VectorXd& x_new, bool again) {
 }
 // The stage increments of a step of size h from (t_, x_), by Newton's method from the last
 // step's polynomial (or zero), with the Jacobian evaluated again where an old one fails.
-bool Radau::try_step(double h, int& iterations, double& theta) {
+template <int S>
+bool RadauIIA<S>::try_step(double h, int& iterations, double& theta) {
   for (;;) {
     if (dense_) {
-      for (int i = 0; i < s_; ++i) {
+      for (int i = 0; i < S; ++i) {
         Z_.col(i) = x_old_ - x_;
-        Z_.col(i).noalias() += Q_.lazyProduct(powers((t_ + tableau_.c[i] * h - t_old_) / h_last_));
+        Z_.col(i).noalias() += Q_ * powers((t_ + c_[i] * h - t_old_) / h_last_);
       }
     } else {
       Z_.setZero();
@@ -293,7 +396,8 @@ bool Radau::try_step(double h, int& iterations, double& theta) {
   }
 }
 
-Radau::Status Radau::step(double t_stop) {
+template <int S>
+typename RadauIIA<S>::Status RadauIIA<S>::step(double t_stop) {
   bool rejected = false;
   for (;;) {
     const double min_step = 10 * (std::nextafter(t_, std::numeric_limits<double>::infinity()) - t_);
@@ -312,9 +416,9 @@ Radau::Status Radau::step(double t_stop) {
       rejected = true;
       continue;
     }
-    x_new_ = x_ + Z_.col(s_ - 1);
+    x_new_ = x_ + Z_.col(S - 1);
     const double error = error_norm(h, x_new_, rejected || first_);
-    const double safety = kSafety * (2 * newton_iterations_ + 1) / (2 * newton_iterations_ + iterations);
+    const double safety = kSafety * (2 * kNewtonIterations + 1) / (2 * kNewtonIterations + iterations);
     if (!std::isfinite(error)) {  // no factor to predict from
       ++stats_.rejected;
       rejected = true;
@@ -324,7 +428,7 @@ Radau::Status Radau::step(double t_stop) {
     if (!(error <= 1)) {
       ++stats_.rejected;
       rejected = true;
-      h_ = h * std::max(kMinShrink, safety * predicted_factor(h, h_old_, error, error_old_, exponent_));
+      h_ = h * std::max(kMinShrink, safety * predicted_factor(h, h_old_, error, error_old_, kExponent));
       continue;
     }
     if (!derivative(t_new, x_new_, b_)) {  // the next step's f(x₀): a step too far
@@ -339,17 +443,18 @@ Radau::Status Radau::step(double t_stop) {
 
 // Moves to the step's end (its f in b_), with the next step's size, and
 // the Jacobian there when the Newton iteration converged slowly.
-bool Radau::accept(double t_new, double h, double error, double safety, int iterations, double theta) {
+template <int S>
+bool RadauIIA<S>::accept(double t_new, double h, double error, double safety, int iterations, double theta) {
   ++stats_.steps;
   x_old_.swap(x_);
   x_.swap(x_new_);
   t_old_ = t_;
   t_ = t_new;
   h_last_ = h;
-  Q_.noalias() = Z_.lazyProduct(tableau_.P);
+  Q_.noalias() = Z_ * P_;
   dense_ = true;
   f0_ = b_;
-  double factor = std::min(kMaxGrowth, safety * predicted_factor(h, h_old_, error, error_old_, exponent_));
+  double factor = std::min(kMaxGrowth, safety * predicted_factor(h, h_old_, error, error_old_, kExponent));
   h_old_ = h;
   error_old_ = error;
   // A Jacobian again where the iteration converged slowly (RADAU5, SciPy), unless it converged
@@ -375,16 +480,25 @@ bool Radau::accept(double t_new, double h, double error, double safety, int iter
 }
 
 // (θ, θ², …, θ^s), for the collocation polynomial.
-const VectorXd& Radau::powers(double theta) const {
-  double p = 1;
-  for (int k = 0; k < s_; ++k) powers_[k] = p *= theta;
-  return powers_;
+template <int S>
+typename RadauIIA<S>::Vector RadauIIA<S>::powers(double theta) {
+  Vector p;
+  double q = 1;
+  for (int k = 0; k < S; ++k) p[k] = q *= theta;
+  return p;
 }
 
-void Radau::interpolate(double t, double* x) const {
+template <int S>
+void RadauIIA<S>::interpolate(double t, double* x) const {
   Eigen::Map<VectorXd> out(x, 2 * n_);
   out = x_old_;
-  out.noalias() += Q_.lazyProduct(powers((t - t_old_) / h_last_));
+  out.noalias() += Q_ * powers((t - t_old_) / h_last_);
+}
+
+std::unique_ptr<Radau> Radau::make(SecondOrderSystem& system, Index n, double rtol, const VectorXd& atol, int stages) {
+  if (stages == 3) return std::make_unique<RadauIIA<3>>(system, n, rtol, atol);
+  if (stages == 5) return std::make_unique<RadauIIA<5>>(system, n, rtol, atol);
+  throw std::invalid_argument("Radau::make: 3 or 5 stages, not " + std::to_string(stages));
 }
 
 }  // namespace mbsgen::detail

@@ -703,18 +703,20 @@ class CvodeIntegrator : public Integrator {
 class RadauIntegrator : public Integrator {
  public:
   RadauIntegrator(Equations& eq, const SimulationOptions& o, const VectorXd& x0)
-      : eq_(eq), radau_(eq, eq.size(), o.rtol, absolute_tolerances(eq.kernels(), o), o.method == IntegrationMethod::radau9 ? 5 : 3) {
+      : eq_(eq),
+        radau_(detail::Radau::make(eq, eq.size(), o.rtol, absolute_tolerances(eq.kernels(), o),
+                                   o.method == IntegrationMethod::radau9 ? 5 : 3)) {
     start(0, x0);
   }
   double step(double, double stop) override {
-    const auto status = radau_.step(stop);
-    if (status == detail::Radau::Status::ok) return radau_.time();
-    const double t = radau_.time();
+    const auto status = radau_->step(stop);
+    if (status == detail::Radau::Status::ok) return radau_->time();
+    const double t = radau_->time();
     std::string why;
     if (status == detail::Radau::Status::failed) {
       why = "the Jacobian cannot be evaluated at the state reached";
     } else {
-      why = "the integrator cannot advance (step size " + short_number(radau_.step_size()) +
+      why = "the integrator cannot advance (step size " + short_number(radau_->step_size()) +
             " s): its error test or Newton iteration keeps failing (the motion is too fast there, or the forces or "
             "parameters are far out of range?)";
     }
@@ -725,10 +727,10 @@ class RadauIntegrator : public Integrator {
   }
   void restart(double t, SimulationResult&) override {
     eq_.start_segment(t);
-    start(t, radau_.state());
+    start(t, radau_->state());
   }
-  const double* state() override { return radau_.state().data(); }
-  void interpolate(double t, double* x) override { radau_.interpolate(t, x); }
+  const double* state() override { return radau_->state().data(); }
+  void interpolate(double t, double* x) override { radau_->interpolate(t, x); }
   [[noreturn]] void too_much_work(double t) override {
     throw SimulationError("simulate: the integration stopped " + at_time(t) + ": more than " +
                               std::to_string(kMaxStepsPerSample) +
@@ -737,7 +739,7 @@ class RadauIntegrator : public Integrator {
                           t);
   }
   void add_statistics(SimulationResult& r) override {
-    const detail::RadauStatistics& s = radau_.statistics();
+    const detail::RadauStatistics& s = radau_->statistics();
     r.steps += s.steps;
     r.rhs_evaluations += s.evaluations;
     r.jacobian_evaluations += s.jacobians;
@@ -748,7 +750,7 @@ class RadauIntegrator : public Integrator {
  private:
   void start(double t, const VectorXd& x) {
     eq_.failure = Equations::Failure::none;
-    if (!radau_.start(t, x))
+    if (!radau_->start(t, x))
       throw SimulationError("simulate: the integration cannot start " + at_time(t) + ": " +
                                 (eq_.failure != Equations::Failure::none
                                      ? eq_.reason()
@@ -757,7 +759,7 @@ class RadauIntegrator : public Integrator {
                             t);
   }
   Equations& eq_;
-  detail::Radau radau_;
+  std::unique_ptr<detail::Radau> radau_;
 };
 
 // The integrator's steps, one at a time (each accepted step moves the closed loops' anchor), up

@@ -2,13 +2,15 @@
 // interposed in this executable and the allocations of compute() are counted for 10 and for
 // 1000 frequencies (each after a warm-up call of the same size); per-call selection work
 // allocates the same in both, so the counts must be equal. And the mass matrix's factorizations
-// and solves at every evaluation of simulate()'s accelerations (runtime/src/block_cholesky.hpp).
+// and solves at every evaluation of simulate()'s accelerations (runtime/src/block_cholesky.hpp),
+// and Radau IIA's steps (runtime/src/radau.hpp).
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
 
 #include "block_cholesky.hpp"
+#include "radau.hpp"
 #include "mbsgen/runtime/frequency_response.hpp"
 #include "models.hpp"
 
@@ -125,5 +127,52 @@ TEST(NoAllocation, MassMatrixSolvesPerEvaluation) {
     }
     g_counting = false;
     EXPECT_EQ(g_allocations.load(), 0) << (dynamic ? "with a dynamic block" : "fixed-size blocks");
+  }
+}
+
+namespace {
+// ÿ = −(y + 0.1 ẏ + y³) (n = 2, uncoupled): the Jacobian changes along the motion.
+class Duffing : public mbsgen::detail::SecondOrderSystem {
+ public:
+  bool accelerations(double, const double* y, const double* v, Eigen::VectorXd& a) override {
+    for (Eigen::Index i = 0; i < 2; ++i) a[i] = -(y[i] + 0.1 * v[i] + y[i] * y[i] * y[i]);
+    return true;
+  }
+  bool has_jacobian() const override { return true; }
+  bool jacobian(double, const double* y, const double*, Eigen::MatrixXd& M, Eigen::MatrixXd& Ky,
+                Eigen::MatrixXd& Kv) override {
+    M.setIdentity();
+    Ky.setZero();
+    Kv = 0.1 * Eigen::MatrixXd::Identity(2, 2);
+    for (Eigen::Index i = 0; i < 2; ++i) Ky(i, i) = 1 + 3 * y[i] * y[i];
+    return true;
+  }
+  bool jacobian_mass(double t, const double* y, const double* v, Eigen::MatrixXd& M, Eigen::VectorXd& a) override {
+    M.setIdentity();
+    return accelerations(t, y, v, a);
+  }
+};
+}  // namespace
+
+// Radau IIA's steps (three and five stages), with their Newton iterations, factorizations,
+// Jacobians, error estimates and dense output, allocate nothing after the first step.
+TEST(NoAllocation, RadauSteps) {
+  if (!MBSGEN_COUNT_ALLOCATIONS) GTEST_SKIP() << "malloc is AddressSanitizer's: not counted";
+  for (const int stages : {3, 5}) {
+    Duffing system;
+    const auto radau = mbsgen::detail::Radau::make(system, 2, 1e-8, Eigen::VectorXd::Constant(4, 1e-10), stages);
+    ASSERT_TRUE(radau->start(0, Eigen::Vector4d(1.5, -0.5, 0, 0)));
+    ASSERT_EQ(radau->step(100), mbsgen::detail::Radau::Status::ok);
+    Eigen::VectorXd x(4);
+    g_allocations = 0;
+    g_counting = true;
+    for (int k = 0; k < 200 && radau->time() < 100; ++k) {
+      if (radau->step(100) != mbsgen::detail::Radau::Status::ok) break;
+      radau->interpolate(radau->time(), x.data());
+    }
+    g_counting = false;
+    EXPECT_EQ(g_allocations.load(), 0) << stages << " stages";
+    EXPECT_GT(radau->statistics().factorizations, 2) << stages << " stages";
+    EXPECT_GT(radau->statistics().steps, 100) << stages << " stages";
   }
 }

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace {
 
@@ -131,14 +132,14 @@ struct Trial {
 // Ten periods at rtol (atol = rtol): the steps and the largest error at the steps.
 Trial oscillate(int stages, double rtol) {
   Oscillator system;
-  Radau radau(system, 1, rtol, VectorXd::Constant(2, rtol), stages);
-  EXPECT_TRUE(radau.start(0, Eigen::Vector2d(1, 0)));
+  const std::unique_ptr<Radau> radau = Radau::make(system, 1, rtol, VectorXd::Constant(2, rtol), stages);
+  EXPECT_TRUE(radau->start(0, Eigen::Vector2d(1, 0)));
   double error = 0;
-  while (radau.time() < 10) {
-    EXPECT_EQ(radau.step(10), Radau::Status::ok);
-    error = std::max(error, std::abs(radau.state()[0] - Oscillator::exact(radau.time())));
+  while (radau->time() < 10) {
+    EXPECT_EQ(radau->step(10), Radau::Status::ok);
+    error = std::max(error, std::abs(radau->state()[0] - Oscillator::exact(radau->time())));
   }
-  return {radau.statistics().steps, error};
+  return {radau->statistics().steps, error};
 }
 
 // The error against the steps, between two tolerances 100 apart: its log–log slope is the order
