@@ -66,7 +66,8 @@ def simulation_section(results, table):
     if not rows:
         return []
     out = ["## 6. Time simulation", "",
-           "`simulate` (SUNDIALS CVODE's BDF and Adams, and our Radau IIA; docs/simulation.md) against SciPy's "
+           "`simulate` (SUNDIALS CVODE's BDF and Adams, and our Radau IIA of orders 5 and 9, `radau` and `radau9`; "
+           "docs/simulation.md) against SciPy's "
            "`solve_ivp` (Radau and LSODA, "
            "Debian python3-scipy) on the same problems, in the same run. SciPy's right-hand side and Jacobian "
            "call the same generated kernels (a shared library through ctypes; M ÿ = −(k − q) by "

@@ -93,11 +93,13 @@ int main(int argc, char** argv) {
       o.atol = o.rtol * p.atol_scale;
       write(dir + "/reference_" + p.name + ".csv", mbsgen::simulate(model, op, o));
     }
-    for (auto method : {mbsgen::IntegrationMethod::bdf, mbsgen::IntegrationMethod::radau, mbsgen::IntegrationMethod::adams}) {
+    for (auto method : {mbsgen::IntegrationMethod::bdf, mbsgen::IntegrationMethod::radau, mbsgen::IntegrationMethod::radau9,
+                        mbsgen::IntegrationMethod::adams}) {
       if (stiff && method == mbsgen::IntegrationMethod::adams) continue;  // 160,000 steps: not its kind of problem
-      const char* name = method == mbsgen::IntegrationMethod::bdf     ? "bdf"
-                         : method == mbsgen::IntegrationMethod::radau ? "radau"
-                                                                      : "adams";
+      const char* name = method == mbsgen::IntegrationMethod::bdf      ? "bdf"
+                         : method == mbsgen::IntegrationMethod::radau  ? "radau"
+                         : method == mbsgen::IntegrationMethod::radau9 ? "radau9"
+                                                                       : "adams";
       // Every half decade, from 1e-4 to 1e-12 (the middle ear's 1e-10): the comparison pairs each
       // SciPy run with our fastest run at least as accurate, so a coarse grid would pair it with a
       // run up to a decade more accurate (and slower) than needed.
@@ -127,7 +129,7 @@ int main(int argc, char** argv) {
         std::snprintf(file, sizeof file, "%s/ours_%s_%s_%g.csv", dir.c_str(), p.name.c_str(), name, rtol);
         write(file, r);
         summary << p.name << "," << name << "," << rtol << "," << median << "," << r.steps << "\n";
-        std::printf("%-16s %-5s rtol %-6g %9.5f s  %7ld steps\n", p.name.c_str(), name, rtol, median, r.steps);
+        std::printf("%-16s %-6s rtol %-6g %9.5f s  %7ld steps\n", p.name.c_str(), name, rtol, median, r.steps);
       }
     }
   }

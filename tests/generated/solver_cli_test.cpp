@@ -226,6 +226,9 @@ TEST(SolverCli, Simulate) {
   ASSERT_EQ(solve({"simulate", "--duration", "0.5", "--step", "0.5", "--format", "json", "--method", "radau"}, &out, &err), 0);
   EXPECT_EQ(out.rfind("{\"model\":\"double_pendulum\",\"scene\":\"full\",\"method\":\"radau\",\"jacobian\":\"kernels\","
                       "\"restarts\":0,\"t\":[0,0.5],\"series\":{\"phi1\":[0,0]", 0), 0u) << out;
+  ASSERT_EQ(solve({"simulate", "--duration", "0.5", "--step", "0.5", "--format", "json", "--method", "radau9"}, &out, &err), 0);
+  EXPECT_EQ(out.rfind("{\"model\":\"double_pendulum\",\"scene\":\"full\",\"method\":\"radau9\",\"jacobian\":\"kernels\","
+                      "\"restarts\":0,\"t\":[0,0.5],\"series\":{\"phi1\":[0,0]", 0), 0u) << out;
   ASSERT_EQ(solve({"simulate", "--duration", "0.5", "--step", "0.5", "--method", "radau", "--statistics"}, &out, &err), 0);
   EXPECT_EQ(err.rfind("simulate: 2 samples, radau, ", 0), 0u) << err;
   EXPECT_NE(err.find(" Jacobians (kernels)"), std::string::npos) << err;
