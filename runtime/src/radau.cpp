@@ -63,9 +63,8 @@ class RadauIIA final : public Radau {
   using Square = Eigen::Matrix<double, S, S>;
   using Vector = Eigen::Matrix<double, S, 1>;
   static constexpr std::size_t kPairs = (S - 1) / 2;  // A⁻¹'s complex eigenvalue pairs
-  // RADAU5's NIT, 7 for three stages; RADAU's for five, 10 (Newton's first iterate is further
-  // from the collocation solution over a longer step).
-  static constexpr int kNewtonIterations = S == 3 ? 7 : 10;
+  // RADAU5's NIT, 7 for three stages; RADAU's for five, 12 (NIT + 5).
+  static constexpr int kNewtonIterations = S == 3 ? 7 : 12;
   static constexpr double kExponent = 1.0 / (S + 1);  // the controller's: the estimate is O(h^(S+1))
 
   bool newton(double h, int& iterations, double& theta);
@@ -116,7 +115,7 @@ class RadauIIA final : public Radau {
   MatrixXd R_;
   Eigen::MatrixXcd Rc_;
   VectorXd x_new_;
-  VectorXd b_, e_, f_, ze_, a_, work_re_, work_im_, quotient_;
+  VectorXd b_, e_, f_, ze_, a_, work_re_, work_im_, quotient_, x_shifted_, a0_;
   Eigen::VectorXcd bc_, yc_;
   RadauStatistics stats_;
 };
@@ -127,7 +126,7 @@ RadauIIA<S>::RadauIIA(SecondOrderSystem& system, Index n, double rtol, const Vec
       newton_tol_(std::max(10 * kEpsilon / rtol, std::min(0.03, std::sqrt(rtol)))), x_(2 * n), x_old_(2 * n),
       f0_(2 * n), scale_(2 * n), Z_(2 * n, S), W_(2 * n, S), Q_(2 * n, S), MJ_(n, n), Ky_(n, n), Kv_(n, n),
       equilibrate_(n), lu_real_(n), G_(2 * n, S), dW_(2 * n, S), stage_(2 * n, S), R_(n, n), Rc_(n, n),
-      x_new_(2 * n), b_(2 * n), e_(2 * n), f_(2 * n), ze_(2 * n), a_(n), work_re_(n), work_im_(n), quotient_(2 * n), bc_(n), yc_(n) {
+      x_new_(2 * n), b_(2 * n), e_(2 * n), f_(2 * n), ze_(2 * n), a_(n), work_re_(n), work_im_(n), quotient_(2 * n), x_shifted_(2 * n), a0_(n), bc_(n), yc_(n) {
   const RadauTableau& t = RadauTableau::of(S);
   c_ = t.c;
   A_invT_ = t.A_inv.transpose();
@@ -171,15 +170,17 @@ bool RadauIIA<S>::start(double t, const VectorXd& x) {
   jacobian_failed_ = false;
   h_old_ = error_old_ = 0;
   if (!derivative(t, x_, f0_) || !evaluate_jacobian(t, x_)) return false;
-  // The first step (Hairer, Nørsett and Wanner I, II.4, as SciPy's select_initial_step for an
-  // error estimate of order 3): from the sizes of x, ẋ and ẍ in the tolerances' units.
+  // The first step (Hairer, Nørsett and Wanner I, II.4, as SciPy's select_initial_step, for an
+  // error estimate of order S): from the sizes of x, ẋ and ẍ in the tolerances' units.
   scale_ = atol_.array() + rtol_ * x_.array().abs();
   const double d0 = norm(x_, scale_), d1 = norm(f0_, scale_);
   const double h0 = d0 < 1e-5 || d1 < 1e-5 ? 1e-6 : 0.01 * d0 / d1;
   b_ = x_ + h0 * f0_;
   if (!derivative(t + h0, b_, f_)) return false;
-  const double d2 = norm(f_ - f0_, scale_) / h0;
-  const double h1 = d1 <= 1e-15 && d2 <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / std::max(d1, d2), 0.25);
+  f_ -= f0_;
+  const double d2 = norm(f_, scale_) / h0;
+  const double h1 =
+      d1 <= 1e-15 && d2 <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / std::max(d1, d2), kExponent);
   h_ = std::min(100 * h0, h1);
   return std::isfinite(h_) && h_ > 0;
 }
@@ -195,7 +196,9 @@ bool RadauIIA<S>::evaluate_jacobian(double t, const VectorXd& x) {
     ++stats_.evaluations;
     if (!system_.jacobian(t, x.data(), x.data() + n_, MJ_, Ky_, Kv_)) return false;
   } else {
-    VectorXd xs = x, a0(n_);
+    VectorXd& xs = x_shifted_;
+    VectorXd& a0 = a0_;
+    xs = x;
     ++stats_.evaluations;
     if (!system_.jacobian_mass(t, x.data(), x.data() + n_, MJ_, a0)) return false;
     for (Index j = 0; j < 2 * n_; ++j) {
@@ -203,7 +206,10 @@ bool RadauIIA<S>::evaluate_jacobian(double t, const VectorXd& x) {
       xs[j] = x[j] + delta;
       ++stats_.evaluations;
       if (!system_.accelerations(t, xs.data(), xs.data() + n_, a_)) return false;
-      (j < n_ ? Ky_.col(j) : Kv_.col(j - n_)).noalias() = -(MJ_ * (a_ - a0)) / (xs[j] - x[j]);
+      work_re_ = a_ - a0;
+      auto column = j < n_ ? Ky_.col(j) : Kv_.col(j - n_);
+      column.noalias() = MJ_ * work_re_;
+      column /= -(xs[j] - x[j]);
       xs[j] = x[j];
     }
   }
@@ -212,14 +218,15 @@ bool RadauIIA<S>::evaluate_jacobian(double t, const VectorXd& x) {
   return true;
 }
 
-// The LUs of the Schur complements σ²M + σK_v + K_y for σ = μ_r/h and μ_c/h, equilibrated as
-// M is; false when one is singular to working precision.
 template <int S>
 template <class Matrix>
 void RadauIIA<S>::equilibrate(Matrix& R) const {
   for (Index j = 0; j < n_; ++j)
     for (Index i = 0; i < n_; ++i) R(i, j) *= equilibrate_[i] * equilibrate_[j];
 }
+
+// The LUs of the Schur complements σ²M + σK_v + K_y for σ = γ/h and each μ_k/h, equilibrated as
+// M is; false when one is singular to working precision.
 
 template <int S>
 bool RadauIIA<S>::factor(double h) {
@@ -291,7 +298,7 @@ void RadauIIA<S>::solve_complex(std::size_t k, const double* b_re, const double*
 // The stage residuals G_i = Ż_i − f(X_i), Ż = h⁻¹ Z A⁻ᵀ, of the stage increments Z_.
 //
 // The explicit form, ÿ = −M(Y_i)⁻¹ r at each stage, rather than M(Y_i) Ż_i + r: the Newton
-// matrix holds one M for all three stages, and where M varies along the step (by 1e-5 of itself
+// matrix holds one M for all the stages, and where M varies along the step (by 1e-5 of itself
 // in the middle ear at 1 Pa), the implicit form's residual no longer matches it. A rotation
 // that barely moves, held to its own small tolerance, then made Newton's iteration converge
 // slowly (two to three iterations more per step, and a Jacobian at most steps).

@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <stdexcept>
+#include <string>
 
 namespace mbsgen::detail {
 
@@ -34,24 +36,30 @@ void radau_polynomial(int s, Real xi, Real& q, Real& dq) {
 }
 
 // The nodes, ascending: the roots of q in ξ = 2c − 1, by Newton's method with the roots found
-// deflated (Maehly), from cos(2πk/(2s − 1)), near Radau's points; ξ = 1 is a root.
+// deflated (Maehly), from cos(2πk/(2s − 1)), near Radau's points; ξ = 1 is a root. Throws where
+// an iteration does not converge or the roots are not distinct inside (−1, 1].
 VectorL nodes(int s) {
   std::vector<Real> roots{1.0L};
   const Real pi = std::acos(-1.0L);
   for (int k = 1; k < s; ++k) {
     Real xi = std::cos(2 * pi * k / (2 * s - 1));
-    for (int iteration = 0; iteration < 100; ++iteration) {
+    bool converged = false;
+    for (int iteration = 0; iteration < 100 && !converged; ++iteration) {
       Real q, dq;
       radau_polynomial(s, xi, q, dq);
       Real deflation = 0;
       for (const Real r : roots) deflation += 1 / (xi - r);
       const Real delta = q / (dq - q * deflation);
       xi -= delta;
-      if (std::abs(delta) <= 4 * std::numeric_limits<Real>::epsilon()) break;
+      converged = std::abs(delta) <= 4 * std::numeric_limits<Real>::epsilon();
     }
+    if (!converged) throw std::logic_error("RadauTableau::compute: a node of " + std::to_string(s) + " stages did not converge");
     roots.push_back(xi);
   }
   std::sort(roots.begin(), roots.end());
+  for (std::size_t i = 0; i < roots.size(); ++i)
+    if (!(roots[i] > -1) || (i > 0 && !(roots[i] > roots[i - 1])))
+      throw std::logic_error("RadauTableau::compute: the nodes of " + std::to_string(s) + " stages are not distinct in (0, 1]");
   VectorL c(s);
   for (int i = 0; i < s; ++i) c[i] = (roots[static_cast<std::size_t>(i)] + 1) / 2;
   c[s - 1] = 1;
@@ -82,6 +90,7 @@ RadauTableau RadauTableau::compute(int s) {
 
   // A⁻¹'s real eigenvector first, then each complex pair's real and imaginary parts.
   Eigen::EigenSolver<MatrixXd> eigen(t.A_inv);
+  if (eigen.info() != Eigen::Success) throw std::logic_error("RadauTableau::compute: A⁻¹'s eigenvalues did not converge");
   const Eigen::VectorXcd lambda = eigen.eigenvalues();
   const Eigen::MatrixXcd vectors = eigen.eigenvectors();
   t.T.resize(s, s);

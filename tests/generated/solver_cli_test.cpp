@@ -231,6 +231,18 @@ TEST(SolverCli, Simulate) {
                       "\"restarts\":0,\"t\":[0,0.5],\"series\":{\"phi1\":[0,0]", 0), 0u) << out;
   ASSERT_EQ(solve({"simulate", "--duration", "0.5", "--step", "0.5", "--method", "radau", "--statistics"}, &out, &err), 0);
   EXPECT_EQ(err.rfind("simulate: 2 samples, radau, ", 0), 0u) << err;
+  {  // radau9 is the five-stage method: fewer than half the steps of radau on 5 s of motion
+    auto steps = [&](const std::string& method) {
+      EXPECT_EQ(solve({"simulate", "--duration", "5", "--step", "5", "--initial", "phi1=0.5", "--rtol", "1e-8", "--method",
+                       method, "--statistics"}, &out, &err), 0) << err;
+      const std::string lead = "simulate: 2 samples, " + method + ", ";
+      EXPECT_EQ(err.rfind(lead, 0), 0u) << err;
+      return std::atol(err.c_str() + std::min(lead.size(), err.size()));
+    };
+    const long five = steps("radau"), nine = steps("radau9");
+    EXPECT_GT(nine, 0);
+    EXPECT_LT(2 * nine, five) << nine << " and " << five << " steps";
+  }
   EXPECT_NE(err.find(" Jacobians (kernels)"), std::string::npos) << err;
   ASSERT_EQ(solve({"simulate", "--duration", "0.5", "--step", "0.5", "--format", "json", "--statistics"}, &out, &err), 0);
   EXPECT_NE(out.find(",\"statistics\":{\"steps\":"), std::string::npos) << out;

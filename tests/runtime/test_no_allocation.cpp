@@ -131,14 +131,16 @@ TEST(NoAllocation, MassMatrixSolvesPerEvaluation) {
 }
 
 namespace {
-// ÿ = −(y + 0.1 ẏ + y³) (n = 2, uncoupled): the Jacobian changes along the motion.
+// ÿ = −(y + 0.1 ẏ + y³) (n = 2, uncoupled): the Jacobian changes along the motion; analytic, or
+// the integrator's difference quotients.
 class Duffing : public mbsgen::detail::SecondOrderSystem {
  public:
+  explicit Duffing(bool analytic) : analytic_(analytic) {}
   bool accelerations(double, const double* y, const double* v, Eigen::VectorXd& a) override {
     for (Eigen::Index i = 0; i < 2; ++i) a[i] = -(y[i] + 0.1 * v[i] + y[i] * y[i] * y[i]);
     return true;
   }
-  bool has_jacobian() const override { return true; }
+  bool has_jacobian() const override { return analytic_; }
   bool jacobian(double, const double* y, const double*, Eigen::MatrixXd& M, Eigen::MatrixXd& Ky,
                 Eigen::MatrixXd& Kv) override {
     M.setIdentity();
@@ -151,15 +153,20 @@ class Duffing : public mbsgen::detail::SecondOrderSystem {
     M.setIdentity();
     return accelerations(t, y, v, a);
   }
+
+ private:
+  bool analytic_;
 };
 }  // namespace
 
 // Radau IIA's steps (three and five stages), with their Newton iterations, factorizations,
-// Jacobians, error estimates and dense output, allocate nothing after the first step.
+// Jacobians (analytic or difference quotients), error estimates and dense output, allocate
+// nothing after the first step.
 TEST(NoAllocation, RadauSteps) {
   if (!MBSGEN_COUNT_ALLOCATIONS) GTEST_SKIP() << "malloc is AddressSanitizer's: not counted";
+  for (const bool analytic : {true, false})
   for (const int stages : {3, 5}) {
-    Duffing system;
+    Duffing system(analytic);
     const auto radau = mbsgen::detail::Radau::make(system, 2, 1e-8, Eigen::VectorXd::Constant(4, 1e-10), stages);
     ASSERT_TRUE(radau->start(0, Eigen::Vector4d(1.5, -0.5, 0, 0)));
     ASSERT_EQ(radau->step(100), mbsgen::detail::Radau::Status::ok);
@@ -171,7 +178,8 @@ TEST(NoAllocation, RadauSteps) {
       radau->interpolate(radau->time(), x.data());
     }
     g_counting = false;
-    EXPECT_EQ(g_allocations.load(), 0) << stages << " stages";
+    EXPECT_EQ(g_allocations.load(), 0) << stages << " stages" << (analytic ? "" : ", difference quotients");
+    EXPECT_GT(radau->statistics().jacobians, 1) << stages << " stages";
     EXPECT_GT(radau->statistics().factorizations, 2) << stages << " stages";
     EXPECT_GT(radau->statistics().steps, 100) << stages << " stages";
   }

@@ -6,8 +6,9 @@
 // with a solve with M at each right-hand side (Cholesky's factors, block by block where M is
 // block diagonal, or the LU's where Cholesky fails; mostly refined on the last factors where M
 // is near them; a singular M is reported at the next fresh factorization, at most 64
-// evaluations after it occurs: docs/simulation.md). Three methods: Radau IIA of order 5 (ours, after
-// RADAU5: stiff and oscillating motion, tight tolerances), and SUNDIALS CVODE's BDF (orders 1–5,
+// evaluations after it occurs: docs/simulation.md). Four methods: Radau IIA of orders 5 and 9 (ours,
+// after RADAU5 and RADAU: stiff and oscillating motion, tight tolerances; order 9 with longer steps
+// on smooth motion), and SUNDIALS CVODE's BDF (orders 1–5,
 // for stiff models such as the middle ear) with Newton's iteration on the Jacobian
 // ∂x'/∂x = [0, I; −M⁻¹ K_y, −M⁻¹ K_v] from the generated kernel `dynamics_jacobian`
 // (K_y = ∂(M ÿ + k − q)/∂y at the current ÿ, K_v = ∂(k − q)/∂ẏ), or from difference quotients
