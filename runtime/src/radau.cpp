@@ -19,7 +19,6 @@ namespace mbsgen::detail {
 namespace {
 
 using Eigen::Index;
-using Eigen::Matrix3d;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using complex = std::complex<double>;
@@ -126,7 +125,8 @@ RadauIIA<S>::RadauIIA(SecondOrderSystem& system, Index n, double rtol, const Vec
       newton_tol_(std::max(10 * kEpsilon / rtol, std::min(0.03, std::sqrt(rtol)))), x_(2 * n), x_old_(2 * n),
       f0_(2 * n), scale_(2 * n), Z_(2 * n, S), W_(2 * n, S), Q_(2 * n, S), MJ_(n, n), Ky_(n, n), Kv_(n, n),
       equilibrate_(n), lu_real_(n), G_(2 * n, S), dW_(2 * n, S), stage_(2 * n, S), R_(n, n), Rc_(n, n),
-      x_new_(2 * n), b_(2 * n), e_(2 * n), f_(2 * n), ze_(2 * n), a_(n), work_re_(n), work_im_(n), quotient_(2 * n), x_shifted_(2 * n), a0_(n), bc_(n), yc_(n) {
+      x_new_(2 * n), b_(2 * n), e_(2 * n), f_(2 * n), ze_(2 * n), a_(n), work_re_(n), work_im_(n), quotient_(2 * n),
+      x_shifted_(2 * n), a0_(n), bc_(n), yc_(n) {
   const RadauTableau& t = RadauTableau::of(S);
   c_ = t.c;
   A_invT_ = t.A_inv.transpose();
