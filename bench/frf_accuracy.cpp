@@ -29,9 +29,9 @@
 #include "models.hpp"
 
 #include "mbsgen/runtime/error.hpp"
-#include "mbsgen/runtime/frequency_response.hpp"
-#include "mbsgen/runtime/matrix_market.hpp"
-#include "mbsgen/runtime/quadratic_eigen.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
+#include "mbsgen/runtime/model/matrix_market.hpp"
+#include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
 #include <complex>
 #include <cstring>

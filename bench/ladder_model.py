@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write the planar ladder of N closed loops as an mbsgen model file (issue 15 §5 benchmark).
 
-The model is generator/chain.hpp's ladder(n) written in YAML (same names, order and values), so
+The model is mbsgen/generator/model/parametric_chains.hpp's ladder(n) written in YAML (same names, order and values), so
 `mbsgen generate` of this file and of the C++ API's model can be compared: two rails of N bars
 (a_i, b_i; length h, relative angles, a joint spring k on each, relaxed when hanging) from pivots
 w apart, and N rungs (rung_i, length w), each a child of rail a's i-th bar and joined to rail b's
@@ -29,7 +29,7 @@ MAX_LOOPS = 1000
 def ladder_yaml(n, independent=False):
     out = [HEADER + " --loops %d%s: a planar ladder of %d closed loops (the model of" % (
         n, " --independent" if independent else "", n),
-        "# generator/chain.hpp ladder(%d)); reference for N = 10: tests/data/reference/loops.json." % n,
+        "# mbsgen/generator/model/parametric_chains.hpp ladder(%d)); reference for N = 10: tests/data/reference/loops.json." % n,
         "model: ladder_%d" % n,
         "",
         "parameters:",

@@ -1,10 +1,10 @@
 // Closed loops (issue 15 §5): generation time of the loaded four-bar and of planar ladders of N
-// closed loops (chain.hpp), medians of 5 runs beside the tree chains' generation in the same run,
+// closed loops (parametric_chains.hpp), medians of 5 runs beside the tree chains' generation in the same run,
 // and the operation counts of their kernels.
 //   loops_bench [max_ladder_n]     the table (docs/generator.md, "Closed loops")
 //   loops_bench --emit DIR         writes the four-bar's kernels (for loops_kernel_timing)
-#include "mbsgen/generator/chain.hpp"
-#include "mbsgen/generator/emit.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
+#include "mbsgen/generator/codegen/emit.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -20,8 +20,8 @@
 #include "middle_ear_model.hpp"
 #include "models.hpp"
 
-#include "mbsgen/runtime/matrix_market.hpp"
-#include "mbsgen/runtime/quadratic_eigen.hpp"
+#include "mbsgen/runtime/model/matrix_market.hpp"
+#include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
 #include <complex>
 #include <filesystem>

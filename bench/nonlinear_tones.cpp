@@ -20,8 +20,8 @@
 
 #include "chain3_sympy_model.hpp"
 #include "jeffcott_rotor_model.hpp"
-#include "mbsgen/runtime/frequency_response.hpp"
-#include "mbsgen/runtime/simulation.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
+#include "mbsgen/runtime/time/simulation.hpp"
 #include "middle_ear_model.hpp"
 
 namespace {

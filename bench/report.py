@@ -177,7 +177,7 @@ METHOD_TEXT = {
     "modal_half_nosc": "modal, ½ of the modes, no static corr.",
     "modal_quarter": "modal, ¼ of the modes + static corr.",
     "modal_quarter_nosc": "modal, ¼ of the modes, no static corr.",
-    "real": "real (DESIGN.md's real form)",
+    "real": "real (docs/design.md's real form)",
     "direct_float": "direct in single precision (cgesv)",
     "banded_float": "banded in single precision (cgbsv)",
     "auto": "**auto**",
@@ -271,7 +271,7 @@ w("- **Frequency responses** (`bench/frf_accuracy.cpp`): per problem F = %d log-
 w("- **Modes** (`bench/modes_accuracy.cpp`): undamped symmetric problems (where all three routes apply), "
   "error of the lowest k = min(f, 20) natural frequencies against 80-digit CLN references (bisection on "
   "the inertia of K − σM for the chains, Newton refinement for the middle ear).")
-w("- **Generation** (`bench/generation_cost.cpp`): the N-link chains of `generator/chain.hpp`, in process; "
+w("- **Generation** (`bench/generation_cost.cpp`): the N-link chains of `mbsgen/generator/model/parametric_chains.hpp`, in process; "
   "the emitted file compiled by the same compiler with `-O2` as a shared library and its `linear` kernel "
   "timed through `dlopen`.")
 w("- **Peers**: SymPy's `KanesMethod` on the same planar chain (`bench/peers/sympy_chain.py`), Octave's "
@@ -541,9 +541,9 @@ w("## 4. Generation")
 w("")
 w("Four variants of the generator on the N-link chains: the structure-aware projection (composite "
   "inertias and subtree wrenches, the CRBA/RNEA form, `Projection::composite`, the default) or the naive "
-  "one (M = Σ J̄ᵀĪJ̄ and k − q = Σ J̄ᵀf̄ body by body, `Projection::naive`, `generator/dynamics.hpp`), each with "
+  "one (M = Σ J̄ᵀĪJ̄ and k − q = Σ J̄ᵀf̄ body by body, `Projection::naive`, `generator/include/mbsgen/generator/mechanics/dynamics.hpp`), each with "
   "and without CSE (`EmitOptions::cse`). The two projections give the same matrices "
-  "(`tests/generator/naive_projection_test.cpp`: exactly for small chains, to 40 digits for the tree models); "
+  "(`tests/generator/mechanics/naive_projection_test.cpp`: exactly for small chains, to 40 digits for the tree models); "
   "here the `linear` kernels of all four agree to rounding (last column). Generation = derive + "
   "linearize + emit, in process; ops = operations (+, −, ×, ÷, calls) of the emitted `linear` kernel (M, Q, K, B, C); "
   "compile = the whole emitted file, `-O2`; kernel = one call of `linear`.")
@@ -607,7 +607,7 @@ if sympy:
       "M, C, K at rest also straight from the equations of motion M(q) u' = f(q, u) — M, −∂f/∂u, −∂f/∂q "
       "at u = 0, the fairest SymPy form of what our `linear` kernel computes — after `sympy.cse`, about any q "
       "and with q = 0 put in (issue 17 §3 quoted the latter: 265 at N = 6; our kernel about any q is held to "
-      "the former and, specialised at y0 = 0, to the latter by `tests/generator/op_count_test.cpp`); "
+      "the former and, specialised at y0 = 0, to the latter by `tests/generator/codegen/op_count_test.cpp`); "
       "the last column compares its M, C, K at q = 0 with ours):")
     w("")
     w(table(["N", "status", "derive", "linearize", "ops of M and forcing", "ops of linear M, A",
@@ -649,8 +649,8 @@ w(engines_section(RESULTS))
 w("## 5. Which method")
 w("")
 w("The recommendation per regime, from the measurements above. The runtime's `auto` "
-  "(`automatic_frf_method`, runtime/src/frequency_response.cpp) implements the frequency-response rows "
-  "marked **auto**; `tests/runtime/test_auto_method.cpp` checks one case per row.")
+  "(`automatic_frf_method`, runtime/src/spectral/frequency_response.cpp) implements the frequency-response rows "
+  "marked **auto**; `tests/runtime/spectral/test_auto_method.cpp` checks one case per row.")
 w("")
 
 

@@ -3,8 +3,8 @@
 // pendulum's in the same run, and their kernels' operation counts (Markdown table; the sweep's
 // time is rolling_sweep_bench's: the generator and the runtime do not share a translation unit).
 //   rolling_bench
-#include "mbsgen/generator/emit.hpp"
-#include "mbsgen/generator/yaml_reader.hpp"
+#include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -3,7 +3,8 @@
 // boundaries), median of 5 runs, beside one evaluation of the descriptor model and its
 // eigenvalues at 5 m/s (the per-speed cost).
 //   rolling_sweep_bench
-#include "mbsgen/runtime/parameter_sweep.hpp"
+#include "mbsgen/runtime/spectral/descriptor_eigen.hpp"
+#include "mbsgen/runtime/spectral/parameter_sweep.hpp"
 #include "whipple_benchmark_model.hpp"
 
 #include <algorithm>

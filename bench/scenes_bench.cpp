@@ -17,12 +17,12 @@
 //   target_compile_definitions(scenes_bench PRIVATE MBSGEN_BENCH_CXX="${CMAKE_CXX_COMPILER}"
 //                                                   MBSGEN_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 //   mbsgen_set_warnings(scenes_bench)
-#include "mbsgen/generator/chain.hpp"
-#include "mbsgen/generator/emit.hpp"
-#include "mbsgen/generator/scene.hpp"
-#include "mbsgen/generator/yaml_reader.hpp"
-#include "mbsgen/runtime/frequency_response.hpp"
-#include "mbsgen/runtime/quadratic_eigen.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
+#include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/scene.hpp"
+#include "mbsgen/generator/model/yaml_reader.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
+#include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
 #include <dlfcn.h>
 
@@ -173,7 +173,7 @@ Row measure(const mbsgen::Model& model, const std::string& scene, const std::str
   return row;
 }
 
-// The planar N-link chain of chain.hpp with an excitation and an output on every link: a
+// The planar N-link chain of parametric_chains.hpp with an excitation and an output on every link: a
 // horizontal force F<i> at mass i and its horizontal position x<i>; the scene frf_tip keeps the
 // force at the tip and the tip's position only.
 mbsgen::Model excited_chain(int n) {

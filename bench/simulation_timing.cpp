@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "double_pendulum_model.hpp"
-#include "mbsgen/runtime/simulation.hpp"
+#include "mbsgen/runtime/time/simulation.hpp"
 #include "middle_ear_model.hpp"
 #include "simple_pendulum_model.hpp"
 

@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """Write the N-link spatial chain as an mbsgen model file (issue 17 §1 benchmark).
 
-The model is generator/chain.hpp's spatial_chain(n) written in YAML (same names, order and
+The model is mbsgen/generator/model/parametric_chains.hpp's spatial_chain(n) written in YAML (same names, order and
 values), so that `mbsgen run` can be timed from a model file: rigid links of length l with full
 inertia tensors about their centres of mass, joined by universal joints (a rotation about x by
 a_i, then about y by b_i, relative to the parent), a torsional spring k and damper c on every
 joint angle, gravity along -z; 2N coordinates; operating point: the equilibrium found from rest
-hanging straight (y = 0, which is one). Scenes no_damping and no_gravity as in chain.cpp.
+hanging straight (y = 0, which is one). Scenes no_damping and no_gravity as in parametric_chains.cpp.
 
 Usage: python3 bench/spatial_chain_model.py [--links N] [-o FILE]
   --links N   number of links (1..1000, default 30)
@@ -22,7 +22,7 @@ MAX_LINKS = 1000
 
 
 def chain_yaml(n):
-    out = [HEADER + " --links %d: the spatial chain of generator/chain.hpp spatial_chain(%d)." % (n, n),
+    out = [HEADER + " --links %d: the spatial chain of mbsgen/generator/model/parametric_chains.hpp spatial_chain(%d)." % (n, n),
            "model: spatial_chain_%d" % n,
            "",
            "parameters:",

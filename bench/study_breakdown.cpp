@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "mbsgen/runtime/frequency_response.hpp"
-#include "mbsgen/runtime/generated_model.hpp"
-#include "mbsgen/runtime/study_design.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
+#include "mbsgen/runtime/model/generated_model.hpp"
+#include "mbsgen/runtime/study/study_design.hpp"
 #include "middle_ear_model.hpp"
 
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));

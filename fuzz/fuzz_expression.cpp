@@ -6,7 +6,7 @@
 // ExpressionError with an offset within the text. Any other exception escapes and aborts, an
 // offset past the end of the text is reported with abort(), and a crash, a sanitizer report, a
 // hang or runaway memory is a finding.
-#include "mbsgen/generator/yaml_reader.hpp"
+#include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include <cstddef>
 #include <cstdint>

@@ -5,7 +5,7 @@
 // a crash, a sanitizer report, a hang (-timeout) or runaway memory (-rss_limit_mb): each is a
 // finding. Built as a libFuzzer binary with clang (MBSGEN_BUILD_FUZZ) and, with any compiler,
 // linked into the smoke driver of the test suite (smoke_driver.cpp).
-#include "mbsgen/generator/yaml_reader.hpp"
+#include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include <cstddef>
 #include <cstdint>

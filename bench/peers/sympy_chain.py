@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """SymPy peer of bench/generation_cost.cpp (issue 7 §4, docs/accuracy-vs-time.md).
 
-Builds the N-link planar chain of mbsgen::planar_chain (generator/src/chain.cpp) with
+Builds the N-link planar chain of mbsgen::planar_chain (generator/src/model/parametric_chains.cpp) with
 sympy.physics.mechanics.KanesMethod — point masses m_i at the ends of massless rods l_i,
 revolute joints about z with relative angles q_i (q_1 from the downward vertical), a torsional
 spring k_i and damper c_i on each relative angle, gravity g along -y — derives the equations of

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "mbsgen/runtime/quadratic_eigen.hpp"
+#include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
 int main() {
   pendulum::Parameters p;  // the model's defaults: m1 = m2 = 1 kg, l1 = l2 = 1 m, g = 9.81

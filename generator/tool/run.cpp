@@ -7,12 +7,12 @@
 
 #include "progress.hpp"
 
-#include "mbsgen/generator/check.hpp"
-#include "mbsgen/generator/emit.hpp"
-#include "mbsgen/generator/emit_api.hpp"
-#include "mbsgen/generator/output_files.hpp"
-#include "mbsgen/generator/scene.hpp"
-#include "mbsgen/generator/yaml_reader.hpp"
+#include "mbsgen/generator/linear/operating_point_check.hpp"
+#include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/codegen/emit_api.hpp"
+#include "mbsgen/generator/codegen/output_files.hpp"
+#include "mbsgen/generator/model/scene.hpp"
+#include "mbsgen/generator/model/yaml_reader.hpp"
 #include "mbsgen_build_config.hpp"
 
 #include <fcntl.h>

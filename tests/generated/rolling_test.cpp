@@ -5,8 +5,8 @@
 #include "rolling_disk_model.hpp"
 #include "whipple_benchmark_model.hpp"
 
-#include "mbsgen/runtime/descriptor_model.hpp"
-#include "mbsgen/runtime/parameter_sweep.hpp"
+#include "mbsgen/runtime/spectral/descriptor_eigen.hpp"
+#include "mbsgen/runtime/spectral/parameter_sweep.hpp"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -30,8 +30,9 @@ std::vector<Mode> modes(const GeneratedModel& model) {
 }
 
 // The four lean–steer eigenvalues of Meijaard et al. (2007), Table 2, recomputed at 40 digits
-// from Table 1 (../shared/reference/bicycle.md), at v = 0, 1, ..., 10 m/s: {re, im} with the
-// conjugate of each complex one implied.
+// from Table 1 (docs/test-references.md, "The Whipple bicycle"; [Meijaard2007] in
+// docs/references.md), at v = 0, 1, ..., 10 m/s: {re, im} with the conjugate of each complex
+// one implied.
 struct Table2Row {
   double v;
   std::vector<std::complex<double>> lambda;
@@ -71,7 +72,7 @@ TEST(WhippleBicycle, EigenvaluesMatchTable2) {
     EXPECT_EQ(zeros, 6) << "v = " << row.v;
     for (const auto& ref : row.lambda) {
       // 1e-12 absolute; 1e-11 for the castering root (the largest in magnitude), whose published
-      // transcriptions differ by up to 6e-13 (bicycle.md).
+      // transcriptions differ by up to 6e-13 (docs/test-references.md, "The Whipple bicycle").
       const double tol = std::abs(ref) > 5.5 && ref.imag() == 0 && ref.real() < 0 ? 1e-11 : 1e-12;
       double best = INFINITY;
       for (const auto& l : finite) best = std::min(best, std::abs(l - ref));
@@ -81,7 +82,8 @@ TEST(WhippleBicycle, EigenvaluesMatchTable2) {
 }
 
 // The model's named parts of the reduced form (reduced_form: {M: M, C1: Q/v, K0: K/g, K2: K/v^2})
-// against the published 14-decimal matrices, recomputed to 17 digits (bicycle.md), at any speed.
+// against the published 14-decimal matrices, recomputed to 17 digits (docs/test-references.md,
+// "The Whipple bicycle"), at any speed.
 TEST(WhippleBicycle, NamedPartsAreTheBenchmarkMatrices) {
   GeneratedModel model(whipple_benchmark::kernels());
   model.set("v", 3.7);  // the parts do not depend on the speed
@@ -120,7 +122,7 @@ TEST(WhippleBicycle, WeaveAndCapsizeSpeeds) {
   const mbsgen::SweepResult r = mbsgen::sweep_parameter(model, "v", 0, 10, 21);
   ASSERT_EQ(r.boundaries.size(), 2u);
   // The weave pair crosses into the left half-plane at v_w, the capsize root into the right at v_c
-  // (bicycle.md: 4.29238253634111 and 6.02426201538837 m/s); 1e-10, the bar.
+  // (docs/test-references.md: 4.29238253634111 and 6.02426201538837 m/s); 1e-10, the bar.
   EXPECT_FALSE(r.boundaries[0].becomes_unstable);
   EXPECT_NEAR(r.boundaries[0].value, 4.29238253634111, 1e-10);
   EXPECT_NEAR(std::abs(r.boundaries[0].eigenvalue.imag()), 3.43503384866144, 1e-8);

@@ -14,8 +14,8 @@
 #include "spherical_pendulum_conical_model.hpp"
 #include "ziegler_column_model.hpp"
 
-#include "mbsgen/runtime/frequency_response.hpp"
-#include "mbsgen/runtime/simulation.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
+#include "mbsgen/runtime/time/simulation.hpp"
 
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
@@ -96,7 +96,7 @@ TEST(Simulation, SimplePendulumPeriodAtLargeAmplitudeMatchesTheEllipticIntegral)
   }
 }
 
-// The total energy of the double pendulum of point masses (closed-forms.md §2 model: m1 = m2 =
+// The total energy of the double pendulum of point masses (docs/test-references.md §2 model: m1 = m2 =
 // 1 kg, l1 = l2 = 1 m), written out here from the coordinates, not from the kernels.
 double double_pendulum_energy(double p1, double p2, double w1, double w2) {
   const double m1 = 1, m2 = 1, l1 = 1, l2 = 1, g = 9.81;
@@ -108,7 +108,7 @@ double double_pendulum_energy(double p1, double p2, double w1, double w2) {
 
 double energy_drift(const GeneratedModel& model, mbsgen::IntegrationMethod method, double p1, double p2, double rtol,
                     long* steps = nullptr) {
-  const double slow = 2 * kPi / std::sqrt((2 - std::sqrt(2.0)) * 9.81);  // closed-forms.md §2
+  const double slow = 2 * kPi / std::sqrt((2 - std::sqrt(2.0)) * 9.81);  // docs/test-references.md §2
   SimulationOptions o;
   o.method = method;
   o.duration = 100 * slow;

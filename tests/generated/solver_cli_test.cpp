@@ -15,8 +15,8 @@
 
 #include "../common/doc_examples.hpp"
 #include "double_pendulum_model.hpp"
-#include "mbsgen/runtime/matrix_market.hpp"
-#include "mbsgen/runtime/solver_cli.hpp"
+#include "mbsgen/runtime/model/matrix_market.hpp"
+#include "mbsgen/runtime/cli/solver_cli.hpp"
 
 #include <sys/stat.h>
 
@@ -25,7 +25,7 @@
 
 namespace {
 
-// Double pendulum, point masses, absolute angles (closed-forms.md §2):
+// Double pendulum, point masses, absolute angles (docs/test-references.md §2):
 // M = [[(m1+m2) l1², m2 l1 l2], [m2 l1 l2, m2 l2²]], K = diag((m1+m2) g l1, m2 g l2), Q = 0.
 TEST(TypedApi, DoublePendulumMatchesClosedForm) {
   double_pendulum::Parameters p;
@@ -270,7 +270,7 @@ TEST(SolverCli, Simulate) {
                       "non-finite values", 0), 0u) << err;
 }
 
-// Same rules and messages as `mbsgen linear frf` (tests/runtime/test_cli.cpp), and the limit on
+// Same rules and messages as `mbsgen linear frf` (tests/runtime/cli/test_cli.cpp), and the limit on
 // --points (kMaxFrequencyPoints).
 TEST(SolverCli, RangeAndPointLimits) {
   std::string err;

@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "base_excited_oscillator_model.hpp"
-#include "mbsgen/runtime/generated_model.hpp"
-#include "mbsgen/runtime/solver_cli.hpp"
-#include "mbsgen/runtime/study.hpp"
-#include "mbsgen/runtime/study_design.hpp"
+#include "mbsgen/runtime/model/generated_model.hpp"
+#include "mbsgen/runtime/cli/solver_cli.hpp"
+#include "mbsgen/runtime/study/study.hpp"
+#include "mbsgen/runtime/study/study_design.hpp"
 
 namespace {
 

@@ -1,10 +1,10 @@
 // Eigenvalues against a parameter (parameter_sweep.hpp, the solvers' `sweep`): the Jeffcott
 // rotor's threshold speed against its closed form Ω_th = √(k/m) (1 + c_n/c_r) = 300 rad/s
-// (models/textbook/jeffcott_rotor.yaml, closed-forms.md §7).
+// (models/textbook/jeffcott_rotor.yaml, docs/test-references.md §7).
 #include "jeffcott_rotor_model.hpp"
 
-#include "mbsgen/runtime/parameter_sweep.hpp"
-#include "mbsgen/runtime/solver_cli.hpp"
+#include "mbsgen/runtime/spectral/parameter_sweep.hpp"
+#include "mbsgen/runtime/cli/solver_cli.hpp"
 
 #include <gtest/gtest.h>
 

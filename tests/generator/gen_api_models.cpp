@@ -1,11 +1,11 @@
-// Writes the generated kernels of a model built through the C++ API (chain.hpp), for its full
+// Writes the generated kernels of a model built through the C++ API (parametric_chains.hpp), for its full
 // model or one of its scenes, optionally with the kernels cut into parts (EmitOptions::parts,
 // chunk_operations; 0 operations: none cut); a full model also gets the dynamics kernel
 // (EmitOptions::dynamics):
 //   gen_api_models planar|spatial|four_bar|ladder N ID OUT_DIR [SCENE [PARTS [CHUNK_OPERATIONS]]]
-#include "mbsgen/generator/chain.hpp"
-#include "mbsgen/generator/emit.hpp"
-#include "mbsgen/generator/scene.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
+#include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/scene.hpp"
 
 #include <iostream>
 #include <string>

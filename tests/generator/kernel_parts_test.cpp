@@ -1,4 +1,4 @@
-// Kernels cut into parts (issue 17 §1, generator/src/emit_chunks.hpp) compute exactly what the
+// Kernels cut into parts (issue 17 §1, generator/src/codegen/emit_chunks.hpp) compute exactly what the
 // whole kernels compute: the same statements in the same order, only some values pass through
 // the workspace. The 6-link spatial chain is generated both ways (tests/generator/CMakeLists.txt:
 // parts of 300 operations in 3 files, and no kernel cut) and every kernel is compared bit for

@@ -1,8 +1,8 @@
 // Generate, compile, evaluate: the emitted kernels of every test model are checked against
-// closed-form eigenvalues (../shared/reference/closed-forms.md), SymPy's exact matrices
-// (sympy_chain3.md), and two invariants that use routes independent of the generator's own:
-// M = Σ J_Tᵀ m J_T + J_Rᵀ I J_R from the body Jacobians, and Q, K, B, C_y, C_v against central
-// finite differences of the nonlinear kernels.
+// closed-form eigenvalues (docs/test-references.md §1–§9), SymPy's exact matrices
+// (docs/test-references.md, "The three-link chain"), and two invariants that use routes
+// independent of the generator's own: M = Σ J_Tᵀ m J_T + J_Rᵀ I J_R from the body Jacobians, and
+// Q, K, B, C_y, C_v against central finite differences of the nonlinear kernels.
 #include "kernel_harness.hpp"
 
 #include <Eigen/Dense>
@@ -142,8 +142,9 @@ TEST(ClosedForm, ZieglerColumnBelowFlutter) {
   expect_eigenvalues("ziegler_column", imaginary_pairs({1 / std::sqrt(2.0), 1.0}));
 }
 
-// sympy_chain3.md: exact M, C, K from SymPy 1.11 KanesMethod; 1e-14 relative allows a few
-// roundings of the emitted arithmetic (each entry is a short sum of products).
+// docs/test-references.md, "The three-link chain": exact M, C, K from SymPy 1.11 KanesMethod;
+// 1e-14 relative allows a few roundings of the emitted arithmetic (each entry is a short sum of
+// products).
 TEST(SymPy, ThreeLinkChainMatricesAndEigenvalues) {
   Linear L = linear_at_default(model("chain3_sympy"));
   MatrixXd M(3, 3), C(3, 3), K(3, 3);

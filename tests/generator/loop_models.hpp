@@ -2,7 +2,7 @@
 // reactions_test.cpp).
 #pragma once
 
-#include "mbsgen/generator/model.hpp"
+#include "mbsgen/generator/model/model.hpp"
 
 #include <string>
 #include <vector>

@@ -6,9 +6,9 @@
 #include "kernel_harness.hpp"
 
 #include "../runtime/hp.hpp"
-#include "mbsgen/runtime/frequency_response.hpp"
-#include "mbsgen/runtime/linear_model.hpp"
-#include "mbsgen/runtime/quadratic_eigen.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
+#include "mbsgen/runtime/model/linear_model.hpp"
+#include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>

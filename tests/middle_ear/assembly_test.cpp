@@ -1,7 +1,8 @@
 // The generated linear kernel of the middle-ear model against an independent, finite-element
-// style assembly of the same 18-coordinate system, written here from the reference notes
-// (../shared/reference/middle-ear.md, "Proposed parameter set") and not from the generator's
-// route (frames, rotation matrices, Newton-Euler projection, symbolic differentiation).
+// style assembly of the same 18-coordinate system, written here from the parameter tables of
+// docs/middle-ear.md ("Parameters and sources": the notes' proposed parameter set, with the
+// sources in docs/references.md) and not from the generator's route (frames, rotation matrices,
+// Newton-Euler projection, symbolic differentiation).
 //
 // Small-displacement field: body b (0 malleus, 1 incus, 2 stapes) has the coordinates
 // q_b = (t_b, θ_b) (translation of its point at the origin, small rotation about the global axes),

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Independent reference for generator/chain.hpp's four_bar_linkage (issue 15 §4).
+"""Independent reference for mbsgen/generator/model/parametric_chains.hpp's four_bar_linkage (issue 15 §4).
 
 One minimal coordinate, the crank angle theta: the loop is closed in closed form (the
 intersection of the circles about the crank's tip and the rocker's pivot, elbow up), the

@@ -522,7 +522,7 @@ def pendulum_cartesian():
 
 
 # ---------------------------------------------------------------------------------------------
-# 5. The ladder of N parallelogram loops (bench/ladder_model.py, = generator/chain.hpp ladder(n)).
+# 5. The ladder of N parallelogram loops (bench/ladder_model.py, = mbsgen/generator/model/parametric_chains.hpp ladder(n)).
 
 LD = dict(h="0.2", w="0.3", m="0.2", k="2")
 
@@ -612,7 +612,7 @@ def ladder(n):
         agree("ladder pin %d y" % i, lam[2 * i + 1], -mm * g_mp / 2)
     wW = eigen_omegas(Mr, Kw)
     return {
-        "model": "bench/ladder_model.py --loops %d (the same model as generator/chain.hpp ladder(%d))" % (n, n),
+        "model": "bench/ladder_model.py --loops %d (the same model as mbsgen/generator/model/parametric_chains.hpp ladder(%d))" % (n, n),
         "what": "planar ladder of %d parallelogram loops hanging straight: rails of bars h = 0.2 m, rungs "
                 "w = 0.3 m, every bar 0.2 kg uniform, joint springs k = 2 N m/rad relaxed when hanging, "
                 "g = 9.81; pin_i joins rung i's end to rail b's bar i" % n,

@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-#include "mbsgen/runtime/frequency_response.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 
 namespace testmodels {
 

@@ -1,0 +1,164 @@
+// Proofs that an expression of the program is zero for all values of its variables
+// (symbolic/zero_proof.hpp).
+#include "symbolic/zero_proof.hpp"
+
+#include "symbolic/type_test.hpp"
+
+#include <algorithm>
+#include <map>
+#include <optional>
+#include <utility>
+#include <vector>
+
+namespace mbsgen {
+
+using GiNaC::ex;
+using GiNaC::cos_SERIAL;
+using GiNaC::sin_SERIAL;
+using GiNaC::tan_SERIAL;
+using detail::kProofBudget;
+using detail::Proof;
+using detail::TreeSize;
+
+namespace {
+
+// sin(a), cos(a), tan(a) → s_a, c_a, s_a/c_a, one pair of symbols per argument a.
+struct TrigToSymbols : GiNaC::map_function {
+  std::map<ex, std::pair<GiNaC::symbol, GiNaC::symbol>, GiNaC::ex_is_less> pairs;
+  const std::pair<GiNaC::symbol, GiNaC::symbol>& pair_of(const ex& a) {
+    auto it = pairs.find(a);
+    if (it == pairs.end()) it = pairs.emplace(a, std::make_pair(GiNaC::symbol(), GiNaC::symbol())).first;
+    return it->second;
+  }
+  ex operator()(const ex& e) override {
+    const bool s = is_ex_the_function(e, sin), c = is_ex_the_function(e, cos),
+               t = is_ex_the_function(e, tan);
+    if (s || c || t) {
+      const ex arg = e.op(0).map(*this);
+      const auto& [sa, ca] = pair_of(arg);
+      return s ? ex(sa) : c ? ex(ca) : ex(sa) / ca;
+    }
+    return e.map(*this);
+  }
+};
+
+// A polynomial in c_a of degree ≤ 1 for every argument a, using c² = 1 − s².
+ex reduce_pythagoras(ex e, const TrigToSymbols& trig) {
+  e = GiNaC::expand(e);
+  for (const auto& [arg, sc] : trig.pairs) {
+    const auto& [s, c] = sc;
+    for (int d = e.degree(c); d >= 2; d = e.degree(c)) {
+      const ex k = e.coeff(c, d);
+      e = GiNaC::expand(e - k * GiNaC::pow(c, d) + k * GiNaC::pow(c, d - 2) * (1 - GiNaC::pow(s, 2)));
+    }
+  }
+  return e;
+}
+
+// Nor are polynomials whose expansion could have more than this many terms
+// (expanded_terms): the expansion's cost follows its terms (about 6 µs each in GiNaC), not the
+// written-out size. The 6-link spatial chain's 66 symmetry proofs of K (structure_of in
+// linearize.cpp; up to 48,896 terms each, 1.15 million in all) took 6 s of its 7 s generation,
+// while from 7 links on they exceed the size budget and the chains generate in 0.2 s. The
+// 5-link chain's (at most 7,120) and every shipped model's (at most 292) stay within it.
+constexpr std::size_t kExpansionBudget = 10000;
+
+// An upper bound of the number of terms of e expanded, saturating at `limit`: a sum's terms add,
+// a product's multiply, a power with a positive integer exponent n raises its base's to n;
+// anything else is one term.
+std::size_t expanded_terms(const ex& e, std::size_t limit) {
+  const auto times = [limit](std::size_t a, std::size_t b) { return b != 0 && a > limit / b ? limit : std::min(limit, a * b); };
+  if (isa<GiNaC::add>(e)) {
+    std::size_t t = 0;
+    for (std::size_t i = 0; i < e.nops() && t < limit; ++i) t = std::min(limit, t + expanded_terms(e.op(i), limit));
+    return t;
+  }
+  if (isa<GiNaC::mul>(e)) {
+    std::size_t t = 1;
+    for (std::size_t i = 0; i < e.nops() && t < limit; ++i) t = times(t, expanded_terms(e.op(i), limit));
+    return t;
+  }
+  if (isa<GiNaC::power>(e) && isa<GiNaC::numeric>(e.op(1)) && GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_pos_integer()) {
+    const std::size_t base = expanded_terms(e.op(0), limit);
+    if (base <= 1) return base;
+    std::size_t t = 1;
+    for (GiNaC::numeric k = GiNaC::ex_to<GiNaC::numeric>(e.op(1)); k.is_positive() && t < limit; k -= 1) t = times(t, base);
+    return t;
+  }
+  return 1;
+}
+
+// Whether e holds a power that is not a positive integer one (a division or a root).
+bool holds_division(const ex& e) {
+  std::vector<ex> stack{e};
+  while (!stack.empty()) {
+    const ex x = stack.back();
+    stack.pop_back();
+    if (isa<GiNaC::power>(x) &&
+        !(isa<GiNaC::numeric>(x.op(1)) && GiNaC::ex_to<GiNaC::numeric>(x.op(1)).is_pos_integer()))
+      return true;
+    for (std::size_t i = 0; i < x.nops(); ++i) stack.push_back(x.op(i));
+  }
+  return false;
+}
+
+// A written-out candidate with sin, cos and tan of each argument as symbols, when it is within
+// the budgets (kProofBudget, kExpansionBudget); nothing otherwise.
+struct ProofForm {
+  TrigToSymbols trig;
+  ex symbolic;
+};
+std::optional<ProofForm> proof_form(const ex& written_out, TreeSize& written_size, bool bound_terms) {
+  if (written_size(written_out) > kProofBudget) return std::nullopt;
+  ProofForm f;
+  f.symbolic = written_out.map(f.trig);
+  // A polynomial's bound is checked before normal(), which expands it (its numerator is the
+  // polynomial). A rational expression's terms can cancel over a common denominator: the Whipple
+  // bicycle's proofs of 115,228 and 471,978 terms so counted have numerators of at most 108.
+  if (bound_terms && !holds_division(f.symbolic) && expanded_terms(f.symbolic, kExpansionBudget + 1) > kExpansionBudget)
+    return std::nullopt;
+  return f;
+}
+
+Proof finish_proof(const ProofForm& f) {
+  const ex numerator = GiNaC::normal(f.symbolic).numer();
+  if (TreeSize(50 * kProofBudget + 1)(numerator) > 50 * kProofBudget) return Proof::too_large;
+  return reduce_pythagoras(numerator, f.trig).is_zero() ? Proof::zero : Proof::nonzero;
+}
+
+}  // namespace
+
+// written_size: a TreeSize with the limit kProofBudget + 1, kept from one candidate to the next.
+Proof detail::prove_zero(const ex& written_out, TreeSize& written_size) {
+  if (written_out.is_zero()) return Proof::zero;
+  const std::optional<ProofForm> f = proof_form(written_out, written_size, true);
+  return f ? finish_proof(*f) : Proof::too_large;
+}
+
+bool proved_zero(Program& program, const ex& e, bool bound_terms) {
+  if (e.is_zero()) return true;
+  TreeSize written_size(kProofBudget + 1);
+  const std::optional<ProofForm> f = proof_form(program.inline_all(e), written_size, bound_terms);
+  return f && finish_proof(*f) == Proof::zero;
+}
+
+bool all_proved_zero(Program& program, std::size_t count, const std::function<ex(std::size_t)>& entry) {
+  // Every one within the budgets first: one beyond them decides, before any is expanded. The
+  // written-out forms share their subtrees (inline_all); the forms with symbols for the sines and
+  // cosines would not, so they are made again for the proofs, one at a time.
+  TreeSize written_size(kProofBudget + 1);
+  std::vector<ex> written;
+  for (std::size_t k = 0; k < count; ++k) {
+    const ex e = entry(k);
+    if (e.is_zero()) continue;
+    const ex written_out = program.inline_all(e);
+    if (written_out.is_zero()) continue;
+    if (!proof_form(written_out, written_size, true)) return false;
+    written.push_back(written_out);
+  }
+  for (const ex& w : written)
+    if (finish_proof(*proof_form(w, written_size, true)) != Proof::zero) return false;
+  return true;
+}
+
+}  // namespace mbsgen

@@ -1,0 +1,95 @@
+// Proofs that an expression of a program is zero for all values of its variables (internal to the
+// generator: the structural zeros of the linear matrices, linear/structural_zeros.cpp, their
+// symmetry and sensitivities, and the constraint equations that vanish identically,
+// mechanics/loop_closure.cpp). Every intermediate is written out, sin and cos of each argument
+// replaced by symbols s, c with c² = 1 − s², the rational normal form's numerator expanded and
+// reduced; an expression beyond the size budgets is not proved (never a wrong zero).
+#pragma once
+
+#include "mbsgen/generator/symbolic/program.hpp"
+
+#include <cstddef>
+#include <functional>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+namespace mbsgen {
+
+/// True when e (an expression of the program) is proved zero for all values of its variables
+/// (false when it is not zero or not proved within the budget). bound_terms = false: without the
+/// bound on the expansion's terms, only on the written-out size (loop closure's test of
+/// constraint equations that vanish identically).
+bool proved_zero(Program& program, const GiNaC::ex& e, bool bound_terms = true);
+/// True when entry(0), …, entry(count − 1) are all proved zero as above; false, before any is
+/// expanded, when one is beyond the budget (entries are formed in order, up to that one).
+bool all_proved_zero(Program& program, std::size_t count, const std::function<GiNaC::ex(std::size_t)>& entry);
+
+namespace detail {
+
+using GiNaC::ex;
+
+// Written-out expressions beyond this many nodes are not expanded (expansion can swell them
+// exponentially); their candidates stay unproved.
+constexpr std::size_t kProofBudget = 20000;
+
+enum class Proof { zero, nonzero, too_large };
+
+// Number of nodes of an expression's tree (shared subtrees counted each time), saturating at
+// `limit`. The sizes of subtrees are kept by node, with the node: the written-out candidates
+// share most of their subtrees (Program::inline_all), and walking each tree anew up to the budget
+// took a third of a 40-link chain's generation once its 6,320 numerically zero entries of N
+// were all candidates.
+class TreeSize {
+ public:
+  explicit TreeSize(std::size_t limit) : limit_(limit) {}
+
+  std::size_t operator()(const ex& root) {
+    struct Frame {
+      ex e;
+      std::size_t next = 0, sum = 1;
+    };
+    std::vector<Frame> stack;
+    std::size_t result = known(root);
+    if (result > 0) return result;
+    stack.push_back({root});
+    while (!stack.empty()) {
+      Frame& f = stack.back();
+      if (f.sum < limit_ && f.next < f.e.nops()) {
+        const ex child = f.e.op(f.next++);
+        if (const std::size_t n = known(child)) {
+          f.sum = std::min(limit_, f.sum + n);
+        } else {
+          stack.push_back({child});  // (f is not used after this)
+        }
+        continue;
+      }
+      const std::size_t n = std::min(limit_, f.sum);
+      sizes_.emplace(&GiNaC::ex_to<GiNaC::basic>(f.e), std::make_pair(f.e, n));
+      stack.pop_back();
+      if (stack.empty())
+        result = n;
+      else
+        stack.back().sum = std::min(limit_, stack.back().sum + n);
+    }
+    return result;
+  }
+
+ private:
+  // The size of a leaf or of a node seen before; 0 otherwise.
+  std::size_t known(const ex& e) const {
+    if (e.nops() == 0) return 1;
+    auto it = sizes_.find(&GiNaC::ex_to<GiNaC::basic>(e));
+    return it == sizes_.end() ? 0 : it->second.second;
+  }
+
+  std::size_t limit_;
+  // node → (the node, kept alive so that its address is not reused; its size)
+  std::unordered_map<const GiNaC::basic*, std::pair<ex, std::size_t>> sizes_;
+};
+
+// written_size: a TreeSize with the limit kProofBudget + 1, kept from one candidate to the next.
+Proof prove_zero(const GiNaC::ex& written_out, TreeSize& written_size);
+
+}  // namespace detail
+}  // namespace mbsgen

@@ -1,0 +1,57 @@
+// Eigenvalues against a parameter, and the parameter values where the stability changes (issue
+// 16 §2: the bicycle's eigenvalues against its speed; any model: a rotor's threshold speed, a
+// column's flutter load).
+#pragma once
+
+#include "mbsgen/runtime/model/generated_model.hpp"
+#include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
+
+#include <complex>
+#include <string>
+#include <vector>
+
+namespace mbsgen {
+
+/// The spectrum at one parameter value.
+struct SweepPoint {
+  double value = 0;
+  /// Finite eigenvalues (both members of a conjugate pair), in QuadraticEigenSolver's order:
+  /// zeros first, then by increasing |λ|.
+  std::vector<std::complex<double>> eigenvalues;
+  /// max Re λ over the finite eigenvalues that are not zero (deflated or within their error
+  /// bound), a real part within its error bound counted as 0; −∞ when there is none. The model
+  /// is unstable at this value when it is > 0.
+  double abscissa = 0;
+  double raw_abscissa = 0;  ///< the same without the error bounds (for refining a boundary)
+  Stability stability = Stability::stable;
+};
+
+/// A value where the largest real part crosses zero: the model turns unstable (or stable) there.
+struct StabilityBoundary {
+  double value = 0;           ///< the parameter value, refined by bisection
+  double tolerance = 0;       ///< |value − true crossing| ≤ tolerance (bisection bracket)
+  bool becomes_unstable = true;  ///< in the direction of increasing parameter
+  std::complex<double> eigenvalue;  ///< the eigenvalue with the largest real part there
+};
+
+struct SweepResult {
+  std::string parameter;
+  std::vector<SweepPoint> points;
+  std::vector<StabilityBoundary> boundaries;
+};
+
+struct SweepOptions {
+  /// Bracket width at which a boundary's bisection stops, relative to max(1, |value|).
+  double relative_tolerance = 1e-14;
+};
+
+/// Sets `parameter` of `model` to `points` values from `from` to `to` (linear spacing, both ends;
+/// points ≥ 2), finds the operating point (Newton for an equilibrium) and the eigenvalues of the
+/// linear model at each, and refines every change of sign of the spectral abscissa between
+/// neighbouring values by bisection. The model's parameter is restored afterwards. Throws
+/// NameError for an unknown parameter, Error for points < 2 or a non-finite range, and what the
+/// model's analyses throw at a value (the message names the value).
+SweepResult sweep_parameter(GeneratedModel& model, const std::string& parameter, double from, double to,
+                            int points, const SweepOptions& options = {});
+
+}  // namespace mbsgen

@@ -1,0 +1,62 @@
+// Bode plots through gnuplot (Debian `gnuplot-nox`): we do not render plots ourselves.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mbsgen/runtime/spectral/parameter_sweep.hpp"
+
+namespace mbsgen::cli {
+
+struct BodePlot {
+  std::string title;
+  std::string amplitude_label;  // e.g. "|v_stapes / P| [(m/s)/Pa]"
+};
+
+/// s as a gnuplot single-quoted string: `'` doubled; controls (newlines included) and DEL become
+/// spaces, bytes that are not well-formed UTF-8 '?'. Gnuplot substitutes nothing inside single
+/// quotes (no backquote commands, no macros), so the string is text and nothing else.
+std::string gnuplot_string(const std::string& s);
+
+/// Writes a Bode plot (amplitude on a log scale and phase lag in degrees over a logarithmic
+/// frequency axis) of g(f) to `path` (.svg or .png). The file is written atomically (a temporary
+/// file created exclusively beside it, then rename); gnuplot runs without a shell on a script in
+/// a private temporary directory (mkdtemp) that names no file: data inline, the plot on its
+/// standard output. Throws mbsgen::Error when gnuplot is missing or fails.
+void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz,
+                     const Eigen::VectorXcd& g, const BodePlot& plot);
+
+struct SweepPlot {
+  std::string title;
+  std::string parameter_label;  // e.g. "v [m/s]"
+};
+
+/// Writes the eigenvalues of a parameter sweep (real parts above, imaginary parts below, the
+/// stability boundaries as dashed vertical lines) to `path`, as write_bode_plot does.
+void write_sweep_plot(const std::string& path, const SweepResult& result, const SweepPlot& plot);
+
+struct TimePlot {
+  std::string title;
+  std::vector<std::string> labels;  // one per series, e.g. "phi [rad]"
+};
+inline constexpr Eigen::Index kMaxTimePanels = 8;
+
+/// Writes series against time (one panel each, 1 to kMaxTimePanels; values: series × samples) to
+/// `path`, as write_bode_plot does. DimensionError for sizes that do not fit.
+void write_time_plot(const std::string& path, const Eigen::VectorXd& t, const Eigen::MatrixXd& values,
+                     const TimePlot& plot);
+
+struct BandPlot {
+  std::string title;
+  std::string amplitude_label;  // e.g. "|v_stapes / P| [(m/s)/Pa]"
+};
+
+/// Writes percentile bands of an amplitude over frequency (log–log): the 5–95 % band shaded, the
+/// 25–75 % band darker, the median as a line; bands rows p5, p25, p50, p75, p95 at hz. As
+/// write_bode_plot does. DimensionError for sizes that do not fit.
+void write_band_plot(const std::string& path, const std::vector<double>& hz,
+                     const std::vector<std::vector<double>>& bands, const BandPlot& plot);
+
+}  // namespace mbsgen::cli
