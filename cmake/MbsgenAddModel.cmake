@@ -106,7 +106,7 @@ function(mbsgen_add_model target)
     file(CONFIGURE OUTPUT ${_main} CONTENT
 "// The solver of ${target} (mbsgen_add_model ... SOLVER). Generated: do not edit.
 #include \"${ARG_ID}_model.hpp\"
-#include \"mbsgen/runtime/solver_cli.hpp\"
+#include \"mbsgen/runtime/cli/solver_cli.hpp\"
 
 int main(int argc, char** argv) { return mbsgen::cli::solver_main(${ARG_ID}::kernels(), argc, argv); }
 " @ONLY)

@@ -103,7 +103,7 @@ Toolchain toolchain() {
   const fs::path prefix = ec ? fs::path() : exe.parent_path().parent_path();
   const fs::path installed_solver = prefix / MBSGEN_INSTALL_LIBDIR / MBSGEN_SOLVER_LIBRARY_NAME;
   if (!prefix.empty() && fs::exists(installed_solver) &&
-      fs::exists(prefix / "include/mbsgen/runtime/solver_cli.hpp")) {
+      fs::exists(prefix / "include/mbsgen/runtime/cli/solver_cli.hpp")) {
     t.includes = {"-I" + (prefix / "include").string()};
     t.libraries = {installed_solver.string(),
                    (prefix / MBSGEN_INSTALL_LIBDIR / MBSGEN_RUNTIME_LIBRARY_NAME).string()};
@@ -384,7 +384,7 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
   try {
     write_generated(code, api, work.string());
     write_files({{work / "main.cpp",
-                  "#include \"model_model.hpp\"\n#include \"mbsgen/runtime/solver_cli.hpp\"\n"
+                  "#include \"model_model.hpp\"\n#include \"mbsgen/runtime/cli/solver_cli.hpp\"\n"
                   "int main(int argc, char** argv) { return mbsgen::cli::solver_main(model::kernels(), argc, argv); }\n"},
                  {work / "model.yaml", text}});  // the model this solver was made from, for reference
     if (!compile_solver(tc, work, code, parallel, progress)) return false;

@@ -322,7 +322,7 @@ std::string hex(const std::string& s) {
 
 // The solver's main: `names` prints every name and unit in hex, anything else is the solver CLI.
 std::string solver_main_source(const std::string& id) {
-  return "#include \"" + id + "_model.hpp\"\n#include \"mbsgen/runtime/solver_cli.hpp\"\n"
+  return "#include \"" + id + "_model.hpp\"\n#include \"mbsgen/runtime/cli/solver_cli.hpp\"\n"
          "#include <cstdio>\n#include <cstring>\n"
          "static void dump(const char* what, const char* const* a, int n) {\n"
          "  for (int i = 0; i < n; ++i) {\n    std::printf(\"%s \", what);\n"

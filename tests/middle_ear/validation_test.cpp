@@ -6,8 +6,8 @@
 // with the tympanometric resonance range of live adults.
 #include "middle_ear_kernel.hpp"
 
-#include <mbsgen/runtime/frequency_response.hpp>
-#include <mbsgen/runtime/quadratic_eigen.hpp>
+#include <mbsgen/runtime/spectral/frequency_response.hpp>
+#include <mbsgen/runtime/spectral/quadratic_eigen.hpp>
 
 #include <gtest/gtest.h>
 
