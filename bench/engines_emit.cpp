@@ -4,8 +4,8 @@
 // a chain's kernels only when the generator's output changed.
 //
 //   engines_emit DIR N...
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 
 #include <cstdio>
 #include <exception>

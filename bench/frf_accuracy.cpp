@@ -29,8 +29,8 @@
 #include "models.hpp"
 
 #include "mbsgen/runtime/error.hpp"
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/model/matrix_market.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
 #include <complex>

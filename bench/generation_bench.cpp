@@ -2,8 +2,8 @@
 // spatial chains, and the operation counts of the emitted kernels. Reports the median of
 // several runs. Usage: generation_bench [max_planar_n] [max_spatial_n] [repeats]
 //        generation_bench --emit DIR   writes the planar 10-link chain's kernels (for kernel_timing)
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -18,8 +18,8 @@
 // bench/peers/sympy_chain.py).
 #include "harness.hpp"
 
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 
 #include <dlfcn.h>
 

@@ -3,8 +3,8 @@
 // and the operation counts of their kernels.
 //   loops_bench [max_ladder_n]     the table (docs/generator.md, "Closed loops")
 //   loops_bench --emit DIR         writes the four-bar's kernels (for loops_kernel_timing)
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 
 #include <algorithm>
 #include <chrono>

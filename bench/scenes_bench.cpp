@@ -17,8 +17,8 @@
 //   target_compile_definitions(scenes_bench PRIVATE MBSGEN_BENCH_CXX="${CMAKE_CXX_COMPILER}"
 //                                                   MBSGEN_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 //   mbsgen_set_warnings(scenes_bench)
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 #include "mbsgen/runtime/spectral/frequency_response.hpp"

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/model/generated_model.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/study/study_design.hpp"
 #include "middle_ear_model.hpp"
 

@@ -1,9 +1,9 @@
 // The mbsgen command: check, info and generate a model; `mbsgen linear` analyses raw matrices.
 // Exit codes: 0 success, 1 a bad model or failed analysis, 2 a usage error.
-#include "mbsgen/generator/linear/operating_point_check.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
-#include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/codegen/emit_api.hpp"
+#include "mbsgen/generator/linear/operating_point_check.hpp"
+#include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include <CLI/CLI.hpp>

@@ -7,10 +7,10 @@
 
 #include "progress.hpp"
 
-#include "mbsgen/generator/linear/operating_point_check.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
 #include "mbsgen/generator/codegen/emit_api.hpp"
 #include "mbsgen/generator/codegen/output_files.hpp"
+#include "mbsgen/generator/linear/operating_point_check.hpp"
 #include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 #include "mbsgen_build_config.hpp"

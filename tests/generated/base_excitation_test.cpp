@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "base_excited_oscillator_model.hpp"
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
-#include "mbsgen/runtime/model/generated_model.hpp"
-#include "mbsgen/runtime/time/simulation.hpp"
 #include "mbsgen/runtime/cli/solver_cli.hpp"
+#include "mbsgen/runtime/model/generated_model.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
+#include "mbsgen/runtime/time/simulation.hpp"
 #include "middle_ear.hpp"
 #include "middle_ear_model.hpp"
 #include "shaken_pendulum_model.hpp"

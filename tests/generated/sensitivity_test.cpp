@@ -21,10 +21,10 @@
 #include "spring_chain_free_free_model.hpp"
 #include "ziegler_column_model.hpp"
 #include "hp.hpp"
+#include "mbsgen/runtime/cli/solver_cli.hpp"
 #include "mbsgen/runtime/model/generated_model.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 #include "mbsgen/runtime/spectral/sensitivity.hpp"
-#include "mbsgen/runtime/cli/solver_cli.hpp"
 #include "middle_ear_model.hpp"
 #include "torqued_pendulum_model.hpp"
 

@@ -15,8 +15,8 @@
 
 #include "../common/doc_examples.hpp"
 #include "double_pendulum_model.hpp"
-#include "mbsgen/runtime/model/matrix_market.hpp"
 #include "mbsgen/runtime/cli/solver_cli.hpp"
+#include "mbsgen/runtime/model/matrix_market.hpp"
 
 #include <sys/stat.h>
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "base_excited_oscillator_model.hpp"
-#include "mbsgen/runtime/model/generated_model.hpp"
 #include "mbsgen/runtime/cli/solver_cli.hpp"
+#include "mbsgen/runtime/model/generated_model.hpp"
 #include "mbsgen/runtime/study/study.hpp"
 #include "mbsgen/runtime/study/study_design.hpp"
 

@@ -3,8 +3,8 @@
 // (models/textbook/jeffcott_rotor.yaml, docs/test-references.md §7).
 #include "jeffcott_rotor_model.hpp"
 
-#include "mbsgen/runtime/spectral/parameter_sweep.hpp"
 #include "mbsgen/runtime/cli/solver_cli.hpp"
+#include "mbsgen/runtime/spectral/parameter_sweep.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,8 +3,8 @@
 // chunk_operations; 0 operations: none cut); a full model also gets the dynamics kernel
 // (EmitOptions::dynamics):
 //   gen_api_models planar|spatial|four_bar|ladder N ID OUT_DIR [SCENE [PARTS [CHUNK_OPERATIONS]]]
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/model/scene.hpp"
 
 #include <iostream>

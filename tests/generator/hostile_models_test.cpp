@@ -11,10 +11,10 @@
 // - the solver draws a Bode plot with gnuplot; a command injected through a string would create
 //   the file `canary`, which must not exist afterwards.
 // OutputFiles, MbsgenCli: write_files, `mbsgen generate --id`, `mbsgen run`'s cache.
-#include "mbsgen/generator/linear/operating_point_check.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
 #include "mbsgen/generator/codegen/emit_api.hpp"
 #include "mbsgen/generator/codegen/output_files.hpp"
+#include "mbsgen/generator/linear/operating_point_check.hpp"
 #include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 #include "mbsgen_build_config.hpp"

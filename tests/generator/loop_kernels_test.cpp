@@ -11,9 +11,9 @@
 #include "slider_crank.hpp"
 #include "rounding.hpp"
 
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/model/generated_model.hpp"
 #include "mbsgen/runtime/model/linear_model.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 
 #include <gtest/gtest.h>
 

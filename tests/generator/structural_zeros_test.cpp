@@ -6,8 +6,8 @@
 #include "kernel_harness.hpp"
 
 #include "../runtime/hp.hpp"
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/model/linear_model.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
 #include <Eigen/Dense>

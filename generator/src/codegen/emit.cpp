@@ -3,11 +3,11 @@
 #include <sched.h>
 #include <unistd.h>
 
-#include "mbsgen/generator/symbolic/canonical.hpp"
 #include "mbsgen/generator/codegen/cse.hpp"
-#include "mbsgen/generator/model/escape.hpp"
 #include "mbsgen/generator/codegen/output_files.hpp"
 #include "mbsgen/generator/linear/sensitivity.hpp"
+#include "mbsgen/generator/model/escape.hpp"
+#include "mbsgen/generator/symbolic/canonical.hpp"
 
 #include "codegen/child_task.hpp"
 #include "codegen/emit_chunks.hpp"

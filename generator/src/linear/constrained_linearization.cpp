@@ -2,11 +2,11 @@
 // named parts of it (linear/constrained_linearization.hpp).
 #include "mbsgen/generator/linear/constrained_linearization.hpp"
 
-#include "mbsgen/generator/mechanics/dynamics.hpp"
 #include "mbsgen/generator/linear/linearize.hpp"
+#include "mbsgen/generator/mechanics/dynamics.hpp"
 
-#include "mechanics/constraint_matrices.hpp"
 #include "linear/sample_points.hpp"
+#include "mechanics/constraint_matrices.hpp"
 
 #include <Eigen/Dense>
 

@@ -2,8 +2,8 @@
 
 #include "mbsgen/generator/model/scene.hpp"
 
-#include "symbolic/checked_subs.hpp"
 #include "model/smoothness_checks.hpp"
+#include "symbolic/checked_subs.hpp"
 
 #include <Eigen/Eigenvalues>
 

@@ -2,8 +2,8 @@
 
 #include "mbsgen/generator/model/escape.hpp"
 
-#include "symbolic/checked_subs.hpp"
 #include "model/expression_sites.hpp"
+#include "symbolic/checked_subs.hpp"
 
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/eventhandler.h>

@@ -2,10 +2,10 @@
 // linearize.cpp decides structural zeros with it, linear/operating_point_check.cpp checks the operating point).
 #pragma once
 
-#include "symbolic/checked_subs.hpp"
-#include "symbolic/type_test.hpp"
 #include "mbsgen/generator/symbolic/ex_table.hpp"
 #include "mbsgen/generator/symbolic/program.hpp"
+#include "symbolic/checked_subs.hpp"
+#include "symbolic/type_test.hpp"
 
 #include <algorithm>
 #include <cstdint>

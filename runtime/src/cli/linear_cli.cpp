@@ -10,10 +10,10 @@
 
 #include "cli/cli_output.hpp"
 #include "mbsgen/runtime/error.hpp"
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/model/generated_model.hpp"
 #include "mbsgen/runtime/model/linear_model.hpp"
 #include "mbsgen/runtime/model/matrix_market.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 #include "mbsgen/runtime/version.hpp"
 

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
-#include "spectral/dense_linear_algebra.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
+#include "spectral/dense_linear_algebra.hpp"
 
 namespace mbsgen {
 

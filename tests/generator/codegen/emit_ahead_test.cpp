@@ -1,8 +1,8 @@
 // Kernels emitted ahead in a child process (emit_ahead, emit.hpp; issue 17 §1) are the code
 // emit() alone writes, byte for byte; a kernel the child made from another derivation or with
 // other options is not taken. And the child process helper itself (child_task.hpp).
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 

@@ -1,8 +1,8 @@
 // Operation counts of the emitted kernels against SymPy's (issue 17 §3), and the polynomial
 // simplification of cse.cpp that gets them there on short chains.
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/cse.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 
 #include <gtest/gtest.h>
 

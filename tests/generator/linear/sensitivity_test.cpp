@@ -3,8 +3,8 @@
 // parameters, and the refusals with their place in the model file.
 #include "mbsgen/generator/codegen/emit.hpp"
 #include "mbsgen/generator/linear/linearize.hpp"
-#include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/linear/sensitivity.hpp"
+#include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include <gtest/gtest.h>

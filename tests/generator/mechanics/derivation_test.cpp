@@ -1,9 +1,9 @@
 // Exact symbolic checks of the derivation on small models: the generator's matrices, with all
 // intermediates written out and exact rational parameters, must equal exact reference matrices.
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/cse.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
 #include "mbsgen/generator/linear/linearize.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include <gtest/gtest.h>

@@ -4,8 +4,8 @@
 // exactly, in rational arithmetic with every intermediate written out, for the 3-link planar and
 // 2-link spatial chains; to 40 digits at pseudo-random points for the tree-structured models
 // (middle ear, sleeping top, rotor). bench/generation_cost.cpp compares their cost.
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/linear/linearize.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include <gtest/gtest.h>

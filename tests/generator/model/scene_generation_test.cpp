@@ -2,9 +2,9 @@
 // linearization equals the full model's with the inactive effects' parameters set to zero
 // (exactly, in rational arithmetic), pruning never adds operations, and the emitted header and
 // manifest say what the scene kept.
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/codegen/emit.hpp"
 #include "mbsgen/generator/codegen/emit_api.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 

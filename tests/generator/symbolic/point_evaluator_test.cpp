@@ -2,12 +2,12 @@
 // the numerical screen of the structural zeros and the symmetry tests) against GiNaC's own
 // evaluation of the written-out expressions, and the compiled program shared by several points
 // against a fresh one per point.
-#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/linear/linearize.hpp"
+#include "mbsgen/generator/model/parametric_chains.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 
-#include "symbolic/point_evaluator.hpp"
 #include "linear/sample_points.hpp"
+#include "symbolic/point_evaluator.hpp"
 
 #include <gtest/gtest.h>
 

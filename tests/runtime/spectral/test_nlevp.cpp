@@ -18,8 +18,8 @@
 #include <string>
 
 #include "hp.hpp"
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/model/matrix_market.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 #include "models.hpp"
 

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "hp.hpp"
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/model/linear_model.hpp"
 #include "mbsgen/runtime/model/matrix_market.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "models.hpp"
 
 namespace {

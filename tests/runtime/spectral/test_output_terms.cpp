@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "hp.hpp"
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
-#include "mbsgen/runtime/model/generated_model.hpp"
 #include "mbsgen/runtime/cli/linear_cli.hpp"
 #include "mbsgen/runtime/cli/solver_cli.hpp"
+#include "mbsgen/runtime/model/generated_model.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "models.hpp"
 
 using mbsgen::FrequencyResponse;

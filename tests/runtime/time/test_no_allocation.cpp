@@ -9,9 +9,9 @@
 #include <atomic>
 #include <cstdlib>
 
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "time/block_cholesky.hpp"
 #include "time/radau.hpp"
-#include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "models.hpp"
 
 // AddressSanitizer owns malloc itself (preset asan): interposing it here would hand glibc's blocks

@@ -5,8 +5,8 @@
 // not finite. ABI version kAbiVersion; see docs/generated-abi.md.
 #pragma once
 
-#include "mbsgen/generator/linear/linearize.hpp"
 #include "mbsgen/generator/codegen/output_files.hpp"
+#include "mbsgen/generator/linear/linearize.hpp"
 #include "mbsgen/generator/model/scene.hpp"
 
 #include <filesystem>

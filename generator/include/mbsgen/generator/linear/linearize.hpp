@@ -5,10 +5,10 @@
 // damping D = sym Q and gyroscopic G = skew Q, K into stiffness sym K and circulatory N = skew K.
 #pragma once
 
-#include "mbsgen/generator/mechanics/dynamics.hpp"
 #include "mbsgen/generator/linear/constrained_linearization.hpp"
-#include "mbsgen/generator/mechanics/nonholonomic.hpp"
 #include "mbsgen/generator/linear/structural_zeros.hpp"
+#include "mbsgen/generator/mechanics/dynamics.hpp"
+#include "mbsgen/generator/mechanics/nonholonomic.hpp"
 
 namespace mbsgen {
 
