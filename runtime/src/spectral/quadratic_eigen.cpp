@@ -391,6 +391,391 @@ void QuadraticEigenSolver::compute_symmetric(const Eigen::MatrixXd& M, const Eig
 // ---------------------------------------------------------------------------------------------
 // General path: scaled first companion linearization; zero and infinite eigenvalues deflated by
 // the staircase above; dggevx with balancing on the remaining (finite) pencil.
+namespace {
+
+/// The finite eigenpairs of one QZ run and how many zero and infinite eigenvalues it deflated.
+struct Run {
+  std::vector<Raw> finite;
+  Eigen::Index zeros = 0, infinities = 0;
+};
+
+/// What the runs of the general path share: the data, their norms and rank decisions, the
+/// solver's workspaces of the linearization and the staircase.
+struct GeneralPath {
+  const Eigen::MatrixXd &M, &Q, &K;
+  const Eigen::MatrixXd &null_K, &null_M;  // right null spaces of K and M
+  Eigen::Index n, N, dK, dM;               // N = 2n; dK, dM: dimensions of the null spaces
+  double fM, fQ, fK;                       // Frobenius norms
+  double rank_tol;
+  double norm_M, norm_Q, norm_K;  // ‖·‖₂ lower estimates
+  bool balance;                   // QuadraticEigenOptions::balance
+  Eigen::MatrixXd &A, &B, &VL, &VR;
+  Eigen::VectorXd &alphar, &alphai, &beta;
+  Staircase st;
+  bool deflating() const { return dK > 0 || dM > 0; }
+  bool degenerate() const { return !(fM > 0 && fK > 0); }
+};
+
+/// Sets A − μB to the first companion linearization of the problem scaled by λ = gμ and d.
+void linearize(GeneralPath& p, double g, double d) {
+  const Eigen::Index n = p.n, N = p.N;
+  p.A.setZero(N, N);
+  p.B.setZero(N, N);
+  p.A.topRightCorner(n, n).setIdentity();
+  p.A.bottomLeftCorner(n, n) = -d * p.K;
+  p.A.bottomRightCorner(n, n) = -(g * d) * p.Q;
+  p.B.topLeftCorner(n, n).setIdentity();
+  p.B.bottomRightCorner(n, n) = (g * g * d) * p.M;
+}
+
+/// Deflates the zero and infinite eigenvalues of A − μB by the staircase p.st and leaves the
+/// remaining pencil, of order m = N − k after k deflated eigenvalues, in A and B.
+void deflate_linearization(GeneralPath& p, Eigen::Index& k, Eigen::Index& m) {
+  const Eigen::Index n = p.n, N = p.N;
+  Staircase& st = p.st;
+  st.tol_A = 2.0 * p.rank_tol * p.A.norm();
+  st.tol_B = 2.0 * p.rank_tol * p.B.norm();
+  st.start(std::move(p.A), std::move(p.B));
+  if (p.dK > 0) {  // null(A) = [N_K; 0]
+    Eigen::MatrixXd Nb = Eigen::MatrixXd::Zero(N, p.dK);
+    Nb.topRows(n) = p.null_K;
+    st.deflate(Nb, true);
+  }
+  if (p.dM > 0) {  // null(B) = [0; N_M], inside the span of the active columns
+    const Eigen::MatrixXd Nb = st.V.block(n, st.c0, n, st.active()).transpose() * p.null_M;
+    st.deflate(Nb, false);
+  }
+  if (p.dK > 0) st.deflate_chains(true);
+  if (p.dM > 0) st.deflate_chains(false);
+  k = st.c0;
+  m = N - k;
+  p.A = st.A.bottomRightCorner(m, m);
+  p.B = st.B.bottomRightCorner(m, m);
+}
+
+/// Eigenvalues (alphar, alphai, beta) and real right and left eigenvectors (VR, VL) of the m×m
+/// pencil (A, B) by dggevx with balancing `job`.
+void qz_pencil(GeneralPath& p, char job, Eigen::Index m) {
+  p.VL.resize(m, m);
+  p.VR.resize(m, m);
+  p.alphar.resize(m);
+  p.alphai.resize(m);
+  p.beta.resize(m);
+  Eigen::VectorXd lscale(m), rscale(m), rconde(m), rcondv(m);
+  lapack_int ilo = 0, ihi = 0;
+  double abnrm = 0, bbnrm = 0;
+  const lapack_int mm = detail::li(m);
+  const lapack_int info = LAPACKE_dggevx(
+      LAPACK_COL_MAJOR, job, 'V', 'V', 'N', mm, p.A.data(), mm, p.B.data(), mm, p.alphar.data(),
+      p.alphai.data(), p.beta.data(), p.VL.data(), mm, p.VR.data(), mm, &ilo, &ihi, lscale.data(),
+      rscale.data(), &abnrm, &bbnrm, rconde.data(), rcondv.data());
+  detail::check_lapack(info, "dggevx", "QuadraticEigenSolver::compute");
+  if (info > 0)
+    throw LapackError("QuadraticEigenSolver::compute: QZ iteration (dggevx) failed");
+}
+
+/// Complex right (Zc) and left (Lc) eigenvectors of the m×m pencil from dggevx's real storage.
+void complex_eigenvectors(const GeneralPath& p, Eigen::Index m, Eigen::MatrixXcd& Zc,
+                          Eigen::MatrixXcd& Lc) {
+  for (Eigen::Index j = 0; j < m; ++j) {
+    if (p.alphai[j] == 0.0) {
+      Zc.col(j) = p.VR.col(j).cast<cd>();
+      Lc.col(j) = p.VL.col(j).cast<cd>();
+    } else if (p.alphai[j] > 0.0) {
+      Zc.col(j).real() = p.VR.col(j);
+      Zc.col(j).imag() = p.VR.col(j + 1);
+      Lc.col(j).real() = p.VL.col(j);
+      Lc.col(j).imag() = p.VL.col(j + 1);
+    } else {  // second of a pair: conjugates of the previous column pair
+      Zc.col(j).real() = p.VR.col(j - 1);
+      Zc.col(j).imag() = -p.VR.col(j);
+      Lc.col(j).real() = p.VL.col(j - 1);
+      Lc.col(j).imag() = -p.VL.col(j);
+    }
+  }
+}
+
+/// The components w_L on the k deflated columns of the right eigenvectors of the full pencil,
+/// one per column w of Zc.
+Eigen::MatrixXcd deflated_components(const GeneralPath& p, Eigen::Index k, Eigen::Index m,
+                                     const Eigen::MatrixXcd& Zc) {
+  const Staircase& st = p.st;
+  Eigen::MatrixXcd WL(k, m);
+  if (k > 0) {
+    const Eigen::MatrixXcd XA = times(st.A.block(0, k, k, m), Zc);
+    const Eigen::MatrixXcd XB = times(st.B.block(0, k, k, m), Zc);
+    const Eigen::MatrixXd LA = st.A.topLeftCorner(k, k), LB = st.B.topLeftCorner(k, k);
+    Eigen::MatrixXcd T(k, k);
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const cd a(p.alphar[j], p.alphai[j]);
+      const double b = p.beta[j];
+      T = b * LA.cast<cd>() - a * LB.cast<cd>();
+      double tmax = 0.0;
+      for (Eigen::Index i = 0; i < k; ++i) tmax = std::max(tmax, std::abs(T(i, i)));
+      for (Eigen::Index i = 0; i < k; ++i)  // an undeflated 0 or ∞ of F: rounding pivot
+        if (T(i, i) == 0.0) T(i, i) = kU * (tmax > 0 ? tmax : 1.0);
+      const Eigen::VectorXcd rhs = -(b * XA.col(j) - a * XB.col(j));
+      WL.col(j) = T.triangularView<Eigen::Upper>().solve(rhs);
+    }
+  }
+  return WL;
+}
+
+/// Right (Z) and left (W, its bottom n rows) eigenvectors of the full linearization from those
+/// of the m×m active pencil after k deflated eigenvalues.
+void full_eigenvectors(const GeneralPath& p, Eigen::Index k, Eigen::Index m, Eigen::MatrixXcd& Zc,
+                       const Eigen::MatrixXcd& Lc, Eigen::MatrixXcd& Z, Eigen::MatrixXcd& W) {
+  // Eigenvectors z = [x; μx] of the full pencil. The left ones are U [0; l]. The right ones
+  // are V [w_L; w] with (βL_A − αL_B) w_L = −(βX_A − αX_B) w, a triangular solve of order k.
+  const Eigen::Index n = p.n;
+  if (!p.deflating()) {
+    Z = std::move(Zc);
+    W = Lc.bottomRows(n);
+  } else {
+    const Staircase& st = p.st;
+    W = times(st.U.block(n, k, n, m), Lc);
+    const Eigen::MatrixXcd WL = deflated_components(p, k, m, Zc);
+    Z = times(st.V.rightCols(m), Zc);
+    if (k > 0) Z += times(st.V.leftCols(k), WL);
+  }
+}
+
+/// The m finite eigenpairs (α, β, x, y) of a run with eigenvalue scaling g, x from the block of z
+/// with the smaller backward error.
+void select_eigenpairs(const GeneralPath& p, double g, Eigen::Index m, const Eigen::MatrixXcd& Z,
+                       const Eigen::MatrixXcd& W, std::vector<Raw>& finite) {
+  const Eigen::Index n = p.n;
+  const Eigen::MatrixXcd top = Z.topRows(n), bottom = Z.bottomRows(n);
+  const Products pt(p.M, p.Q, p.K, top), pb(p.M, p.Q, p.K, bottom);
+  finite.clear();
+  finite.reserve(static_cast<std::size_t>(m));
+  for (Eigen::Index j = 0; j < m; ++j) {
+    Raw r;
+    r.alpha = g * cd(p.alphar[j], p.alphai[j]);
+    r.beta = p.beta[j];
+    normalize_pair(r.alpha, r.beta);
+    const double nt = top.col(j).norm(), nb = bottom.col(j).norm();
+    const double e_top =
+        nt > 0 ? pt.backward_error(j, r.alpha, r.beta, nt, p.norm_M, p.norm_Q, p.norm_K) : kInf;
+    const double e_bot =
+        nb > 0 ? pb.backward_error(j, r.alpha, r.beta, nb, p.norm_M, p.norm_Q, p.norm_K) : kInf;
+    r.x = e_top <= e_bot ? top.col(j) : bottom.col(j);
+    r.eta = std::min(e_top, e_bot);
+    r.y = W.col(j);
+    finite.push_back(std::move(r));
+  }
+}
+
+/// QZ of the m×m pencil (A, B) by dggevx with balancing `job`, eigenvectors of the full
+/// linearization, x from the block of z with the smaller backward error.
+void qz(GeneralPath& p, char job, double g, Eigen::Index k, Eigen::Index m,
+        std::vector<Raw>& finite) {
+  qz_pencil(p, job, m);
+  // Complex right and left eigenvectors of the active pencil.
+  Eigen::MatrixXcd Zc(m, m), Lc(m, m);
+  complex_eigenvectors(p, m, Zc, Lc);
+  Eigen::MatrixXcd Z, W;
+  full_eigenvectors(p, k, m, Zc, Lc, Z, W);
+  select_eigenpairs(p, g, m, Z, W, finite);
+}
+
+/// The largest backward error of a run's finite eigenpairs.
+double largest_backward_error(const std::vector<Raw>& v) {
+  double e = 0.0;
+  for (const Raw& r : v) e = std::max(e, r.eta);
+  return e;
+}
+
+/// QZ of the m×m pencil (A, B) with the balancing of the options: permutation, or permutation and
+/// scaling when that gives the smaller largest backward error.
+void qz_balanced(GeneralPath& p, double g, Eigen::Index k, Eigen::Index m,
+                 std::vector<Raw>& finite) {
+  // Balancing of the linearization: permutation ('P') first. LAPACK's scaling (Ward's
+  // algorithm in dggbal, 'B') is not normwise safe: on damped ear-scaled chains of 30-100
+  // masses it cost two to three digits of backward error (5.4e-13 against the bar
+  // 100·f·u = 3.3e-13 at f = 30, 4.1e-12 at f = 100; 1.2e-15 and 3.7e-15 with permutation
+  // only), and it was nowhere needed for the bar in the tests. It remains the fallback: when
+  // the largest backward error exceeds 10·f·u, the pencil is solved again with 'B' and the run
+  // with the smaller largest backward error is kept. After a deflation, permutation only: the
+  // orthogonal transformations leave rounding-level residue where the linearization had exact
+  // zeros, which steers the scaling into factors of 1e5 (measured: residuals 2.8e-12 instead
+  // of 1.4e-16 on a heavily damped free-free chain).
+  if (!p.balance) {
+    qz(p, 'N', g, k, m, finite);
+    return;
+  }
+  const bool deflating = p.deflating();
+  const Eigen::MatrixXd A_keep = deflating ? Eigen::MatrixXd() : p.A;
+  const Eigen::MatrixXd B_keep = deflating ? Eigen::MatrixXd() : p.B;
+  qz(p, 'P', g, k, m, finite);
+  if (!deflating && largest_backward_error(finite) > 10.0 * static_cast<double>(p.n) * kU) {
+    p.A = A_keep;
+    p.B = B_keep;
+    std::vector<Raw> alt;
+    qz(p, 'B', g, k, m, alt);
+    if (largest_backward_error(alt) < largest_backward_error(finite)) finite.swap(alt);
+  }
+}
+
+/// One run on the problem scaled by λ = gμ and d: linearization, deflation of the zero and
+/// infinite eigenvalues, balanced QZ of the remaining pencil.
+void run_scaled(GeneralPath& p, double g, double d, Run& out) {
+  linearize(p, g, d);
+  const bool deflating = p.deflating();
+  Eigen::Index k = 0, m = p.N;
+  if (deflating) deflate_linearization(p, k, m);
+  out.zeros = deflating ? p.st.zeros : 0;
+  out.infinities = deflating ? p.st.infinities : 0;
+  out.finite.clear();
+  if (m == 0) return;
+  qz_balanced(p, g, k, m, out.finite);
+}
+
+/// The scaling to use: `scaling` with automatic resolved by τ, and tropical only when it applies.
+QuadraticEigenOptions::Scaling choose_scaling(QuadraticEigenOptions::Scaling scaling,
+                                              const GeneralPath& p, double tau) {
+  const bool degenerate = p.degenerate();
+  if (scaling == QuadraticEigenOptions::Scaling::automatic)
+    scaling = (!degenerate && p.fQ > 0 && tau >= 10.0)
+                  ? QuadraticEigenOptions::Scaling::tropical
+                  : QuadraticEigenOptions::Scaling::fan_lin_van_dooren;
+  if (scaling == QuadraticEigenOptions::Scaling::tropical && (degenerate || p.fQ == 0))
+    scaling = QuadraticEigenOptions::Scaling::fan_lin_van_dooren;
+  return scaling;
+}
+
+/// The run with the Fan-Lin-Van Dooren scaling (γ = √(‖K‖/‖M‖), δ = 2/(‖K‖ + γ‖Q‖)).
+void run_fan_lin_van_dooren(GeneralPath& p, std::string& method, Run& r) {
+  method = "fan_lin_van_dooren";
+  const bool degenerate = p.degenerate();
+  const double g = degenerate ? 1.0 : std::sqrt(p.fK / p.fM);
+  const double den = degenerate ? std::max({p.fM, p.fQ, p.fK}) : 0.5 * (p.fK + g * p.fQ);
+  run_scaled(p, g, den > 0 ? 1.0 / den : 1.0, r);
+}
+
+/// Order of finite eigenpairs by |λ|.
+bool by_size(const Raw& a, const Raw& b) { return a.size() < b.size(); }
+
+/// Whether splitting v (sorted by size) before index c cuts a conjugate pair.
+bool pair_split(const std::vector<Raw>& v, Eigen::Index c) {
+  const auto i = static_cast<std::size_t>(c);
+  return i > 0 && i < v.size() && v[i].alpha == std::conj(v[i - 1].alpha) &&
+         v[i].alpha.imag() != 0.0;
+}
+
+/// The tropical result when there are deflated eigenvalues: a third, Fan-Lin-Van Dooren run, and
+/// three consecutive blocks of finite eigenvalues with the split points of least backward error.
+void combine_three_runs(GeneralPath& p, Run& big, Run& small, Run& result) {
+  Run mid;
+  const double g = std::sqrt(p.fK / p.fM);
+  run_scaled(p, g, 1.0 / (0.5 * (p.fK + g * p.fQ)), mid);
+  std::stable_sort(big.finite.begin(), big.finite.end(), by_size);
+  std::stable_sort(small.finite.begin(), small.finite.end(), by_size);
+  std::stable_sort(mid.finite.begin(), mid.finite.end(), by_size);
+  const bool use_mid = mid.zeros == small.zeros && mid.infinities == small.infinities;
+  const auto mf = small.finite.size();
+  std::vector<double> head(mf + 1, 0.0), tail(mf + 1, 0.0);
+  for (std::size_t i = 0; i < mf; ++i) head[i + 1] = std::max(head[i], small.finite[i].eta);
+  for (std::size_t i = mf; i-- > 0;) tail[i] = std::max(tail[i + 1], big.finite[i].eta);
+  auto splits = [&](std::size_t c) {
+    const auto ci = static_cast<Eigen::Index>(c);
+    return pair_split(small.finite, ci) || pair_split(big.finite, ci) ||
+           (use_mid && pair_split(mid.finite, ci));
+  };
+  std::size_t c1 = 0, c2 = 0;
+  double best = kInf;
+  for (std::size_t a = 0; a <= mf; ++a) {
+    if (splits(a)) continue;
+    double mid_max = 0.0;
+    for (std::size_t b = a; b <= mf; ++b) {
+      if (b > a) {
+        if (!use_mid) break;
+        mid_max = std::max(mid_max, mid.finite[b - 1].eta);
+      }
+      if (splits(b)) continue;
+      const double worst = std::max({head[a], mid_max, tail[b]});
+      if (worst < best) {  // strict: ties keep the smaller FLV block found first
+        best = worst;
+        c1 = a;
+        c2 = b;
+      }
+    }
+  }
+  result.zeros = small.zeros;
+  result.infinities = small.infinities;
+  const auto d1 = static_cast<std::ptrdiff_t>(c1), d2 = static_cast<std::ptrdiff_t>(c2);
+  result.finite.assign(small.finite.begin(), small.finite.begin() + d1);
+  if (c2 > c1)
+    result.finite.insert(result.finite.end(), mid.finite.begin() + d1, mid.finite.begin() + d2);
+  result.finite.insert(result.finite.end(), big.finite.begin() + d2, big.finite.end());
+}
+
+/// The runs with tropical scaling and their combined finite eigenpairs.
+void run_tropical(GeneralPath& p, std::string& method, Run& result) {
+  // Tropical scaling (Gaubert & Sharify 2009, as used by quadeig): the n largest eigenvalues
+  // from the run scaled by γ+ = ‖Q‖/‖M‖, the n smallest from the run scaled by γ− = ‖K‖/‖Q‖.
+  // Deflated zero and infinite eigenvalues upset these counts and can leave finite ones
+  // between the two groups; then a third run with the Fan-Lin-Van Dooren scaling is added and
+  // the finite eigenvalues, sorted by |λ| in all three runs, are taken as three consecutive
+  // blocks (from the γ−, the FLV and the γ+ run) with the split points that minimize the
+  // largest backward error.
+  method = "tropical";
+  Run big, small;
+  const double gp = p.fQ / p.fM, gm = p.fK / p.fQ;
+  run_scaled(p, gp, 1.0 / std::max({p.fK, gp * p.fQ, gp * gp * p.fM}), big);
+  run_scaled(p, gm, 1.0 / std::max({p.fK, gm * p.fQ, gm * gm * p.fM}), small);
+  if (big.zeros != small.zeros || big.infinities != small.infinities) {
+    // Rank decisions differ between the scalings: one run.
+    run_fan_lin_van_dooren(p, method, result);
+  } else if (small.zeros == 0 && small.infinities == 0) {
+    std::stable_sort(big.finite.begin(), big.finite.end(), by_size);
+    std::stable_sort(small.finite.begin(), small.finite.end(), by_size);
+    Eigen::Index cut = p.n;  // keep conjugate pairs together: the split must not cut a pair
+    if (pair_split(small.finite, cut)) cut += 1;
+    result.finite.assign(small.finite.begin(), small.finite.begin() + cut);
+    result.finite.insert(result.finite.end(), big.finite.begin() + cut, big.finite.end());
+  } else {
+    combine_three_runs(p, big, small, result);
+  }
+}
+
+/// Appends the modes of `count` deflated zero or infinite eigenvalues (eigenvectors from pairs).
+void push_null_modes(const NullPairs& pairs, Eigen::Index count, EigenvalueKind kind,
+                     bool one_per_conjugate_pair, std::vector<Mode>& modes) {
+  for (Eigen::Index j = 0; j < count; ++j) {
+    if (one_per_conjugate_pair && kind == EigenvalueKind::zero && j >= pairs.x.cols())
+      continue;  // a Jordan chain's extra zeros: listed once
+    const Eigen::Index c = pairs.column(j);
+    Mode md;
+    md.kind = kind;
+    md.alpha = kind == EigenvalueKind::zero ? cd(0.0) : cd(1.0);
+    md.beta = kind == EigenvalueKind::zero ? 1.0 : 0.0;
+    md.defective = pairs.defective(c, count);
+    md.shape = pairs.x.col(c).cast<cd>();
+    md.left_shape = pairs.y.col(c).cast<cd>();
+    modes.push_back(std::move(md));
+  }
+}
+
+/// Appends the modes of the finite eigenpairs, moving their eigenvectors.
+void push_finite_modes(std::vector<Raw>& finite, bool one_per_conjugate_pair,
+                       std::vector<Mode>& modes) {
+  for (Raw& r : finite) {
+    if (one_per_conjugate_pair && r.alpha.imag() < 0.0) continue;
+    Mode m;
+    m.alpha = r.alpha;
+    m.beta = r.beta;
+    m.kind = EigenvalueKind::finite;
+    m.shape = std::move(r.x);
+    m.left_shape = std::move(r.y);
+    modes.push_back(std::move(m));
+  }
+}
+
+}  // namespace
+
+// The general path: null-vector pairs of the deflated eigenvalues, the runs of the chosen scaling
+// and the modes.
 void QuadraticEigenSolver::compute_general(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
                                            const Eigen::MatrixXd& K) {
   const Eigen::Index n = M.rows(), N = 2 * n;
@@ -409,289 +794,29 @@ void QuadraticEigenSolver::compute_general(const Eigen::MatrixXd& M, const Eigen
   zero_pairs.compute(null_K_, WK, Q);
   inf_pairs.compute(null_M_, WM, Q);
 
-  struct Run {
-    std::vector<Raw> finite;
-    Eigen::Index zeros = 0, infinities = 0;
-  };
-  Staircase st;
-  auto run = [&](double g, double d, Run& out) {
-    A_.setZero(N, N);
-    B_.setZero(N, N);
-    A_.topRightCorner(n, n).setIdentity();
-    A_.bottomLeftCorner(n, n) = -d * K;
-    A_.bottomRightCorner(n, n) = -(g * d) * Q;
-    B_.topLeftCorner(n, n).setIdentity();
-    B_.bottomRightCorner(n, n) = (g * g * d) * M;
-    const bool deflating = dK > 0 || dM > 0;
-    Eigen::Index k = 0, m = N;
-    if (deflating) {
-      st.tol_A = 2.0 * rank_tol * A_.norm();
-      st.tol_B = 2.0 * rank_tol * B_.norm();
-      st.start(std::move(A_), std::move(B_));
-      if (dK > 0) {  // null(A) = [N_K; 0]
-        Eigen::MatrixXd Nb = Eigen::MatrixXd::Zero(N, dK);
-        Nb.topRows(n) = null_K_;
-        st.deflate(Nb, true);
-      }
-      if (dM > 0) {  // null(B) = [0; N_M], inside the span of the active columns
-        const Eigen::MatrixXd Nb =
-            st.V.block(n, st.c0, n, st.active()).transpose() * null_M_;
-        st.deflate(Nb, false);
-      }
-      if (dK > 0) st.deflate_chains(true);
-      if (dM > 0) st.deflate_chains(false);
-      k = st.c0;
-      m = N - k;
-      A_ = st.A.bottomRightCorner(m, m);
-      B_ = st.B.bottomRightCorner(m, m);
-    }
-    out.zeros = deflating ? st.zeros : 0;
-    out.infinities = deflating ? st.infinities : 0;
-    out.finite.clear();
-    if (m == 0) return;
-    // QZ of the m×m pencil (A_, B_) by dggevx with balancing `job`, eigenvectors of the full
-    // linearization, x from the block of z with the smaller backward error.
-    auto qz = [&](char job, std::vector<Raw>& finite) {
-      VL_.resize(m, m);
-      VR_.resize(m, m);
-      alphar_.resize(m);
-      alphai_.resize(m);
-      beta_.resize(m);
-      Eigen::VectorXd lscale(m), rscale(m), rconde(m), rcondv(m);
-      lapack_int ilo = 0, ihi = 0;
-      double abnrm = 0, bbnrm = 0;
-      const lapack_int mm = detail::li(m);
-      const lapack_int info = LAPACKE_dggevx(
-          LAPACK_COL_MAJOR, job, 'V', 'V', 'N', mm, A_.data(), mm, B_.data(), mm, alphar_.data(),
-          alphai_.data(), beta_.data(), VL_.data(), mm, VR_.data(), mm, &ilo, &ihi, lscale.data(),
-          rscale.data(), &abnrm, &bbnrm, rconde.data(), rcondv.data());
-      detail::check_lapack(info, "dggevx", "QuadraticEigenSolver::compute");
-      if (info > 0)
-        throw LapackError("QuadraticEigenSolver::compute: QZ iteration (dggevx) failed");
-      // Complex right and left eigenvectors of the active pencil.
-      Eigen::MatrixXcd Zc(m, m), Lc(m, m);
-      for (Eigen::Index j = 0; j < m; ++j) {
-        if (alphai_[j] == 0.0) {
-          Zc.col(j) = VR_.col(j).cast<cd>();
-          Lc.col(j) = VL_.col(j).cast<cd>();
-        } else if (alphai_[j] > 0.0) {
-          Zc.col(j).real() = VR_.col(j);
-          Zc.col(j).imag() = VR_.col(j + 1);
-          Lc.col(j).real() = VL_.col(j);
-          Lc.col(j).imag() = VL_.col(j + 1);
-        } else {  // second of a pair: conjugates of the previous column pair
-          Zc.col(j).real() = VR_.col(j - 1);
-          Zc.col(j).imag() = -VR_.col(j);
-          Lc.col(j).real() = VL_.col(j - 1);
-          Lc.col(j).imag() = -VL_.col(j);
-        }
-      }
-      // Eigenvectors z = [x; μx] of the full pencil. The left ones are U [0; l]. The right ones
-      // are V [w_L; w] with (βL_A − αL_B) w_L = −(βX_A − αX_B) w, a triangular solve of order k.
-      Eigen::MatrixXcd Z, W;
-      if (!deflating) {
-        Z = std::move(Zc);
-        W = Lc.bottomRows(n);
-      } else {
-        W = times(st.U.block(n, k, n, m), Lc);
-        Eigen::MatrixXcd WL(k, m);
-        if (k > 0) {
-          const Eigen::MatrixXcd XA = times(st.A.block(0, k, k, m), Zc);
-          const Eigen::MatrixXcd XB = times(st.B.block(0, k, k, m), Zc);
-          const Eigen::MatrixXd LA = st.A.topLeftCorner(k, k), LB = st.B.topLeftCorner(k, k);
-          Eigen::MatrixXcd T(k, k);
-          for (Eigen::Index j = 0; j < m; ++j) {
-            const cd a(alphar_[j], alphai_[j]);
-            const double b = beta_[j];
-            T = b * LA.cast<cd>() - a * LB.cast<cd>();
-            double tmax = 0.0;
-            for (Eigen::Index i = 0; i < k; ++i) tmax = std::max(tmax, std::abs(T(i, i)));
-            for (Eigen::Index i = 0; i < k; ++i)  // an undeflated 0 or ∞ of F: rounding pivot
-              if (T(i, i) == 0.0) T(i, i) = kU * (tmax > 0 ? tmax : 1.0);
-            const Eigen::VectorXcd rhs = -(b * XA.col(j) - a * XB.col(j));
-            WL.col(j) = T.triangularView<Eigen::Upper>().solve(rhs);
-          }
-        }
-        Z = times(st.V.rightCols(m), Zc);
-        if (k > 0) Z += times(st.V.leftCols(k), WL);
-      }
-      const Eigen::MatrixXcd top = Z.topRows(n), bottom = Z.bottomRows(n);
-      const Products pt(M, Q, K, top), pb(M, Q, K, bottom);
-      finite.clear();
-      finite.reserve(static_cast<std::size_t>(m));
-      for (Eigen::Index j = 0; j < m; ++j) {
-        Raw r;
-        r.alpha = g * cd(alphar_[j], alphai_[j]);
-        r.beta = beta_[j];
-        normalize_pair(r.alpha, r.beta);
-        const double nt = top.col(j).norm(), nb = bottom.col(j).norm();
-        const double e_top =
-            nt > 0 ? pt.backward_error(j, r.alpha, r.beta, nt, norm_M_, norm_Q_, norm_K_) : kInf;
-        const double e_bot =
-            nb > 0 ? pb.backward_error(j, r.alpha, r.beta, nb, norm_M_, norm_Q_, norm_K_) : kInf;
-        r.x = e_top <= e_bot ? top.col(j) : bottom.col(j);
-        r.eta = std::min(e_top, e_bot);
-        r.y = W.col(j);
-        finite.push_back(std::move(r));
-      }
-    };
-    auto worst = [](const std::vector<Raw>& v) {
-      double e = 0.0;
-      for (const Raw& r : v) e = std::max(e, r.eta);
-      return e;
-    };
-    // Balancing of the linearization: permutation ('P') first. LAPACK's scaling (Ward's
-    // algorithm in dggbal, 'B') is not normwise safe: on damped ear-scaled chains of 30-100
-    // masses it cost two to three digits of backward error (5.4e-13 against the bar
-    // 100·f·u = 3.3e-13 at f = 30, 4.1e-12 at f = 100; 1.2e-15 and 3.7e-15 with permutation
-    // only), and it was nowhere needed for the bar in the tests. It remains the fallback: when
-    // the largest backward error exceeds 10·f·u, the pencil is solved again with 'B' and the run
-    // with the smaller largest backward error is kept. After a deflation, permutation only: the
-    // orthogonal transformations leave rounding-level residue where the linearization had exact
-    // zeros, which steers the scaling into factors of 1e5 (measured: residuals 2.8e-12 instead
-    // of 1.4e-16 on a heavily damped free-free chain).
-    if (!options_.balance) {
-      qz('N', out.finite);
-      return;
-    }
-    const Eigen::MatrixXd A_keep = deflating ? Eigen::MatrixXd() : A_;
-    const Eigen::MatrixXd B_keep = deflating ? Eigen::MatrixXd() : B_;
-    qz('P', out.finite);
-    if (!deflating && worst(out.finite) > 10.0 * static_cast<double>(n) * kU) {
-      A_ = A_keep;
-      B_ = B_keep;
-      std::vector<Raw> alt;
-      qz('B', alt);
-      if (worst(alt) < worst(out.finite)) out.finite.swap(alt);
-    }
-  };
-
-  const bool degenerate = !(fM > 0 && fK > 0);
-  auto scaling = options_.scaling;
-  if (scaling == QuadraticEigenOptions::Scaling::automatic)
-    scaling = (!degenerate && fQ > 0 && tau_ >= 10.0)
-                  ? QuadraticEigenOptions::Scaling::tropical
-                  : QuadraticEigenOptions::Scaling::fan_lin_van_dooren;
-  if (scaling == QuadraticEigenOptions::Scaling::tropical && (degenerate || fQ == 0))
-    scaling = QuadraticEigenOptions::Scaling::fan_lin_van_dooren;
-
-  auto fan_lin_van_dooren = [&](Run& r) {
-    method_ = "fan_lin_van_dooren";
-    const double g = degenerate ? 1.0 : std::sqrt(fK / fM);
-    const double den = degenerate ? std::max({fM, fQ, fK}) : 0.5 * (fK + g * fQ);
-    run(g, den > 0 ? 1.0 / den : 1.0, r);
-  };
+  GeneralPath p{M, Q, K, null_K_, null_M_,  // data
+                n, N, dK, dM, fM, fQ, fK, rank_tol, norm_M_, norm_Q_, norm_K_, options_.balance,
+                A_, B_, VL_, VR_, alphar_, alphai_, beta_,  // workspaces
+                {}};
+  const auto scaling = choose_scaling(options_.scaling, p, tau_);
   Run result;
   if (scaling == QuadraticEigenOptions::Scaling::none) {
     method_ = "none";
-    run(1.0, 1.0, result);
+    run_scaled(p, 1.0, 1.0, result);
   } else if (scaling == QuadraticEigenOptions::Scaling::fan_lin_van_dooren) {
-    fan_lin_van_dooren(result);
+    run_fan_lin_van_dooren(p, method_, result);
   } else {
-    // Tropical scaling (Gaubert & Sharify 2009, as used by quadeig): the n largest eigenvalues
-    // from the run scaled by γ+ = ‖Q‖/‖M‖, the n smallest from the run scaled by γ− = ‖K‖/‖Q‖.
-    // Deflated zero and infinite eigenvalues upset these counts and can leave finite ones
-    // between the two groups; then a third run with the Fan-Lin-Van Dooren scaling is added and
-    // the finite eigenvalues, sorted by |λ| in all three runs, are taken as three consecutive
-    // blocks (from the γ−, the FLV and the γ+ run) with the split points that minimize the
-    // largest backward error.
-    method_ = "tropical";
-    Run big, small;
-    const double gp = fQ / fM, gm = fK / fQ;
-    run(gp, 1.0 / std::max({fK, gp * fQ, gp * gp * fM}), big);
-    run(gm, 1.0 / std::max({fK, gm * fQ, gm * gm * fM}), small);
-    auto by_size = [](const Raw& a, const Raw& b) { return a.size() < b.size(); };
-    auto pair_split = [](const std::vector<Raw>& v, Eigen::Index c) {
-      const auto i = static_cast<std::size_t>(c);
-      return i > 0 && i < v.size() && v[i].alpha == std::conj(v[i - 1].alpha) &&
-             v[i].alpha.imag() != 0.0;
-    };
-    if (big.zeros != small.zeros || big.infinities != small.infinities) {
-      fan_lin_van_dooren(result);  // rank decisions differ between the scalings: one run
-    } else if (small.zeros == 0 && small.infinities == 0) {
-      std::stable_sort(big.finite.begin(), big.finite.end(), by_size);
-      std::stable_sort(small.finite.begin(), small.finite.end(), by_size);
-      Eigen::Index cut = n;  // keep conjugate pairs together: the split must not cut a pair
-      if (pair_split(small.finite, cut)) cut += 1;
-      result.finite.assign(small.finite.begin(), small.finite.begin() + cut);
-      result.finite.insert(result.finite.end(), big.finite.begin() + cut, big.finite.end());
-    } else {
-      Run mid;
-      const double g = std::sqrt(fK / fM);
-      run(g, 1.0 / (0.5 * (fK + g * fQ)), mid);
-      std::stable_sort(big.finite.begin(), big.finite.end(), by_size);
-      std::stable_sort(small.finite.begin(), small.finite.end(), by_size);
-      std::stable_sort(mid.finite.begin(), mid.finite.end(), by_size);
-      const bool use_mid = mid.zeros == small.zeros && mid.infinities == small.infinities;
-      const auto mf = small.finite.size();
-      std::vector<double> head(mf + 1, 0.0), tail(mf + 1, 0.0);
-      for (std::size_t i = 0; i < mf; ++i) head[i + 1] = std::max(head[i], small.finite[i].eta);
-      for (std::size_t i = mf; i-- > 0;) tail[i] = std::max(tail[i + 1], big.finite[i].eta);
-      auto splits = [&](std::size_t c) {
-        const auto ci = static_cast<Eigen::Index>(c);
-        return pair_split(small.finite, ci) || pair_split(big.finite, ci) ||
-               (use_mid && pair_split(mid.finite, ci));
-      };
-      std::size_t c1 = 0, c2 = 0;
-      double best = kInf;
-      for (std::size_t a = 0; a <= mf; ++a) {
-        if (splits(a)) continue;
-        double mid_max = 0.0;
-        for (std::size_t b = a; b <= mf; ++b) {
-          if (b > a) {
-            if (!use_mid) break;
-            mid_max = std::max(mid_max, mid.finite[b - 1].eta);
-          }
-          if (splits(b)) continue;
-          const double worst = std::max({head[a], mid_max, tail[b]});
-          if (worst < best) {  // strict: ties keep the smaller FLV block found first
-            best = worst;
-            c1 = a;
-            c2 = b;
-          }
-        }
-      }
-      result.zeros = small.zeros;
-      result.infinities = small.infinities;
-      const auto d1 = static_cast<std::ptrdiff_t>(c1), d2 = static_cast<std::ptrdiff_t>(c2);
-      result.finite.assign(small.finite.begin(), small.finite.begin() + d1);
-      if (c2 > c1)
-        result.finite.insert(result.finite.end(), mid.finite.begin() + d1,
-                             mid.finite.begin() + d2);
-      result.finite.insert(result.finite.end(), big.finite.begin() + d2, big.finite.end());
-    }
+    run_tropical(p, method_, result);
   }
 
   num_zero_ = result.zeros;
   num_infinite_ = result.infinities;
   modes_.clear();
-  auto push_null = [&](const NullPairs& pairs, Eigen::Index count, EigenvalueKind kind) {
-    for (Eigen::Index j = 0; j < count; ++j) {
-      if (options_.one_per_conjugate_pair && kind == EigenvalueKind::zero && j >= pairs.x.cols())
-        continue;  // a Jordan chain's extra zeros: listed once
-      const Eigen::Index c = pairs.column(j);
-      Mode md;
-      md.kind = kind;
-      md.alpha = kind == EigenvalueKind::zero ? cd(0.0) : cd(1.0);
-      md.beta = kind == EigenvalueKind::zero ? 1.0 : 0.0;
-      md.defective = pairs.defective(c, count);
-      md.shape = pairs.x.col(c).cast<cd>();
-      md.left_shape = pairs.y.col(c).cast<cd>();
-      modes_.push_back(std::move(md));
-    }
-  };
-  push_null(zero_pairs, num_zero_, EigenvalueKind::zero);
-  push_null(inf_pairs, num_infinite_, EigenvalueKind::infinite);
-  for (Raw& r : result.finite) {
-    if (options_.one_per_conjugate_pair && r.alpha.imag() < 0.0) continue;
-    Mode m;
-    m.alpha = r.alpha;
-    m.beta = r.beta;
-    m.kind = EigenvalueKind::finite;
-    m.shape = std::move(r.x);
-    m.left_shape = std::move(r.y);
-    modes_.push_back(std::move(m));
-  }
+  push_null_modes(zero_pairs, num_zero_, EigenvalueKind::zero, options_.one_per_conjugate_pair,
+                  modes_);
+  push_null_modes(inf_pairs, num_infinite_, EigenvalueKind::infinite,
+                  options_.one_per_conjugate_pair, modes_);
+  push_finite_modes(result.finite, options_.one_per_conjugate_pair, modes_);
 }
 
 void QuadraticEigenSolver::finish(const Eigen::MatrixXd& M, const Eigen::MatrixXd& Q,
