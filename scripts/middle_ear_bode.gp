@@ -49,7 +49,7 @@ set key at graph 0.995, graph 0.99 right top box opaque font ",9" spacing 1.1 sa
 plot \
   refdata using 1:8:9 with filledcurves lc rgb "#bcd4ee" fs solid 0.7 noborder title band_title, \
   keyentry with lines lc rgb "white" title band_title2, \
-  dir."/default.csv" skip 1 using 1:(mag($2,$3)) with lines lw 2.5 lc rgb "#000000" title "model, default parameters (the notes' set)", \
+  dir."/default.csv" skip 1 using 1:(mag($2,$3)) with lines lw 2.5 lc rgb "#000000" title "model, default parameters (docs/middle-ear.md)", \
   dir."/fixation10.csv" skip 1 using 1:(mag($2,$3)) with lines lw 1.8 dt 2 lc rgb "#d95f02" title "stapes fixation: annular ligament k, k_{rot} x10", \
   dir."/fixation100.csv" skip 1 using 1:(mag($2,$3)) with lines lw 1.8 dt 4 lc rgb "#7570b3" title "stapes fixation: annular ligament k, k_{rot} x100", \
   keyentry with lines lw 1.8 dt 3 lc rgb "#1b9e77" title isj_note, \
