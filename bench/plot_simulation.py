@@ -114,7 +114,7 @@ set format y '10^{%L}'
 set grid
 set key top right
 set xlabel 'run time [s] (median)'
-set ylabel 'error against the reference run'
+set ylabel 'relative error against the reference run, max|y - y_ref| / max|y_ref|' noenhanced
 set title 'Work and precision: """ + p.replace("_", " ") + """'
 plot """ + ", ".join(plots)
         gnuplot(images, work, "work_precision_" + p, body)

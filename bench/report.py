@@ -370,12 +370,13 @@ for p in main_problems:
                 plots.append("'%s' using 1:2 with points pt 7 ps 1.2 lc rgb '%s' title '%s'" % (f, colours[k], names[k]))
                 plots.append("'%s' using 4:5:3 with labels left font ',9' tc rgb '%s' noenhanced notitle"
                              % (f, colours[k]))
-        body = ("set logscale xy\nset grid\nset key bottom right box opaque\n"
+        # The legend beside the plot: inside, its opaque box hid the points under it.
+        body = ("set logscale xy\nset grid\nset key outside right top box\n"
                 "set xlabel 'time per frequency at F = %d [s]'\nset ylabel 'largest relative error'\n"
                 "set format x '10^{%%L}'\nset format y '10^{%%L}'\nset yrange [1e-17:100]\n"
                 "set title \"%s\" noenhanced\nset offsets graph 0.05, graph 0.25, 0, 0\nplot %s"
                 % (F_REPORT, label[p].replace('"', "'"), ", ".join(plots)))
-        w(gnuplot("frf_" + p, body))
+        w(gnuplot("frf_" + p, body, size=(960, 500)))
         w("")
 
 # chain scaling
@@ -532,7 +533,7 @@ for m, c in (("polyeig", "#d62728"), ("eig", "#e377c2"), ("eigs", "#ff7f0e")):
                       % (write_data("modes_oct_%s.dat" % m, data), c, m))
 if series:
     w(gnuplot("modes_scaling", "set logscale xy\nset grid\nset key top left box opaque\n"
-              "set xlabel 'n'\nset ylabel 'time [s]'\nset format y '10^{%L}'\n"
+              "set xlabel 'n (masses)'\nset ylabel 'time [s]'\nset format y '10^{%L}'\n"
               "set title 'Undamped ear-scaled chain: modes (with vectors) against size'\nplot " + ", ".join(series)))
     w("")
 

@@ -9,14 +9,18 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <system_error>
+#include <utility>
+#include <vector>
 
 #include "mbsgen/runtime/error.hpp"
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
@@ -149,14 +153,15 @@ std::string gnuplot_string(const std::string& s) {
 namespace {
 
 // Renders the script that `script(terminal)` gives to `path` (.svg or .png), atomically, with
-// gnuplot run without a shell in a private directory (see write_bode_plot).
-void render(const std::string& path, const std::function<std::string(const std::string&)>& script_for) {
+// gnuplot run without a shell in a private directory (see write_bode_plot); `size` in pixels.
+void render(const std::string& path, const std::function<std::string(const std::string&)>& script_for,
+            const std::string& size = "900,700") {
   const std::string ext = fs::path(path).extension().string();
   std::string terminal;
   if (ext == ".svg")
-    terminal = "svg size 900,700 dynamic enhanced font 'Sans,12' background rgb 'white'";
+    terminal = "svg size " + size + " dynamic enhanced font 'Sans,12' background rgb 'white'";
   else if (ext == ".png")
-    terminal = "pngcairo size 900,700 enhanced font 'Sans,11'";
+    terminal = "pngcairo size " + size + " enhanced font 'Sans,11'";
   else
     throw Error("--plot " + path + ": the file name must end in .svg or .png");
 
@@ -199,28 +204,360 @@ void render(const std::string& path, const std::function<std::string(const std::
 }
 
 
-// The eigenvalues against the parameter: real parts above, imaginary parts below, the
-// stability boundaries as vertical lines.
+// The sweep plot (issue 44 §2): every line, band and boundary named in a legend. What the sweep
+// can tell is named from the data: a boundary where a complex pair crosses the imaginary axis is
+// oscillatory (flutter, a Hopf point), one where a real eigenvalue crosses is a divergence; the
+// branch that crosses there is found by continuation; the exact zeros the solver deflated
+// (SweepPoint::zeros) are drawn as one grey line, not as a branch. Names such as "weave" come
+// from the user (SweepPlot::boundary_names).
+
+// A real eigenvalue: QZ gives Im λ exactly 0 for those; the tolerance only keeps the rounding of
+// a pair that just split off the real axis from counting as real.
+bool is_real(std::complex<double> l) { return std::abs(l.imag()) <= 1e-10 * std::abs(l); }
+
+std::string format_number(double x, const char* format) {
+  char b[64];
+  std::snprintf(b, sizeof b, format, x);
+  return b;
+}
+
+// "4.292 m/s": a parameter value with its unit (none for "" and "-").
+std::string with_unit(double x, const std::string& unit) {
+  return format_number(x, "%.4g") + (unit.empty() || unit == "-" ? "" : " " + unit);
+}
+
+// The branches of the nonzero eigenvalues through the sweep, by continuation: at each point the
+// eigenvalues are matched to the branches' linear extrapolations, nearest pair first.
+// branches[j][k]: branch j at point k, NaN where it has none. Empty when the spectrum is too
+// large for the quadratic matching to be cheap (the plot then names no branch).
+using Branches = std::vector<std::vector<std::complex<double>>>;
+constexpr std::size_t kMaxTrackedEigenvalues = 200;
+
+Branches track_branches(const std::vector<SweepPoint>& points) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::complex<double> none(nan, nan);
+  Branches branches;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    std::vector<std::complex<double>> found;
+    for (std::size_t i = points[k].zeros; i < points[k].eigenvalues.size(); ++i) {
+      const std::complex<double> l = points[k].eigenvalues[i];
+      if (std::isfinite(l.real()) && std::isfinite(l.imag())) found.push_back(l);
+    }
+    if (found.size() > kMaxTrackedEigenvalues) return {};
+    std::vector<std::size_t> live;
+    std::vector<std::complex<double>> predicted;
+    for (std::size_t j = 0; j < branches.size(); ++j) {
+      if (k == 0 || std::isnan(branches[j][k - 1].real())) continue;
+      const std::complex<double> last = branches[j][k - 1];
+      const bool two = k >= 2 && !std::isnan(branches[j][k - 2].real());
+      live.push_back(j);
+      predicted.push_back(two ? 2.0 * last - branches[j][k - 2] : last);
+    }
+    struct Match {
+      double distance;
+      std::size_t branch, eigenvalue;
+    };
+    std::vector<Match> matches;
+    for (std::size_t b = 0; b < live.size(); ++b)
+      for (std::size_t e = 0; e < found.size(); ++e) matches.push_back({std::abs(predicted[b] - found[e]), b, e});
+    std::sort(matches.begin(), matches.end(), [](const Match& x, const Match& y) {
+      return x.distance < y.distance || (x.distance == y.distance && (x.branch < y.branch ||
+                                                                      (x.branch == y.branch && x.eigenvalue < y.eigenvalue)));
+    });
+    for (auto& b : branches) b.push_back(none);
+    std::vector<bool> branch_done(live.size()), eigenvalue_done(found.size());
+    for (const Match& m : matches) {
+      if (branch_done[m.branch] || eigenvalue_done[m.eigenvalue]) continue;
+      branches[live[m.branch]][k] = found[m.eigenvalue];
+      branch_done[m.branch] = eigenvalue_done[m.eigenvalue] = true;
+    }
+    for (std::size_t e = 0; e < found.size(); ++e) {
+      if (eigenvalue_done[e]) continue;
+      branches.emplace_back(k, none);
+      branches.back().push_back(found[e]);
+    }
+  }
+  return branches;
+}
+
+// The branches that cross the imaginary axis at boundary b: among those whose real part changes
+// sign between the two points around b, the one nearest b's eigenvalue and, for a complex pair,
+// the one nearest its conjugate. Empty when no branch changes sign there.
+std::vector<std::size_t> crossing_branches(const Branches& branches, const std::vector<SweepPoint>& points,
+                                           const StabilityBoundary& b) {
+  if (branches.empty() || points.size() < 2) return {};
+  std::size_t k = 1;
+  double best_gap = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    const double lo = std::min(points[i - 1].value, points[i].value), hi = std::max(points[i - 1].value, points[i].value);
+    const double gap = b.value < lo ? lo - b.value : (b.value > hi ? b.value - hi : 0.0);
+    if (gap < best_gap) {
+      best_gap = gap;
+      k = i;
+    }
+  }
+  const std::size_t unstable = points[k].abscissa > 0 ? k : k - 1;
+  std::vector<std::size_t> changing;
+  for (std::size_t j = 0; j < branches.size(); ++j) {
+    const std::complex<double> x = branches[j][k - 1], y = branches[j][k];
+    if (std::isnan(x.real()) || std::isnan(y.real())) continue;
+    if ((x.real() > 0) != (y.real() > 0)) changing.push_back(j);
+  }
+  const auto nearest = [&](std::complex<double> target, std::size_t other) {
+    std::size_t best = branches.size();
+    double d = std::numeric_limits<double>::infinity();
+    for (const std::size_t j : changing) {
+      if (j == other || !(std::abs(branches[j][unstable] - target) < d)) continue;
+      d = std::abs(branches[j][unstable] - target);
+      best = j;
+    }
+    return best;
+  };
+  std::vector<std::size_t> crossing;
+  const std::size_t first = nearest(b.eigenvalue, branches.size());
+  if (first == branches.size()) return crossing;
+  crossing.push_back(first);
+  if (!is_real(b.eigenvalue)) {
+    const std::size_t second = nearest(std::conj(b.eigenvalue), first);
+    if (second != branches.size()) crossing.push_back(second);
+  }
+  return crossing;
+}
+
+// The parameter intervals between the sweep's ends and its boundaries in which no point is
+// unstable and some point has a decided negative spectral abscissa (the exact zeros aside).
+std::vector<std::pair<double, double>> stable_intervals(const SweepResult& r) {
+  std::vector<double> edges;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const SweepPoint& p : r.points) {
+    lo = std::min(lo, p.value);
+    hi = std::max(hi, p.value);
+  }
+  edges.push_back(lo);
+  for (const StabilityBoundary& b : r.boundaries) edges.push_back(b.value);
+  edges.push_back(hi);
+  std::sort(edges.begin() + 1, edges.end() - 1);
+  std::vector<std::pair<double, double>> stable;
+  for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
+    bool unstable = false, negative = false;
+    for (const SweepPoint& p : r.points) {
+      if (p.value < edges[i] || p.value > edges[i + 1]) continue;
+      if (p.value != edges[i] && p.value != edges[i + 1]) unstable = unstable || p.abscissa > 0;
+      negative = negative || (std::isfinite(p.abscissa) && p.abscissa < 0);
+    }
+    if (negative && !unstable && edges[i + 1] > edges[i]) stable.emplace_back(edges[i], edges[i + 1]);
+  }
+  return stable;
+}
+
+// A legend entry for each boundary and a name for the branches that cross it.
+struct NamedBranch {
+  std::string label;
+  std::vector<std::size_t> branches;
+};
+struct BoundaryNames {
+  std::vector<std::string> labels;    ///< per boundary, in order of the parameter
+  std::vector<NamedBranch> branches;  ///< one per boundary (no branch when none was found)
+  bool any_named = false;
+};
+
+// Each boundary named by the user or by what crosses there (a complex pair: oscillatory, with its
+// frequency; a real eigenvalue: divergence), and the branches that cross it, each named once (at
+// its first boundary).
+BoundaryNames name_boundaries(const std::vector<const StabilityBoundary*>& boundaries, const Branches& branches,
+                              const SweepResult& r, const SweepPlot& plot, const std::string& parameter) {
+  BoundaryNames out;
+  std::vector<bool> named(branches.size());
+  for (std::size_t i = 0; i < boundaries.size(); ++i) {
+    const StabilityBoundary& b = *boundaries[i];
+    const bool oscillatory = !is_real(b.eigenvalue);
+    const std::string given = i < plot.boundary_names.size() ? plot.boundary_names[i] : std::string();
+    const std::string at = parameter + " = " + with_unit(b.value, plot.unit);
+    std::string label = given.empty() ? (oscillatory ? "oscillatory boundary " : "divergence boundary ") : given + " boundary ";
+    label += at + (oscillatory ? " (complex pair, " + format_number(std::abs(b.eigenvalue.imag()) / (2 * kPi), "%.3g") + " Hz)"
+                               : " (real eigenvalue)");
+    out.labels.push_back(label);
+    NamedBranch n;
+    n.label = given.empty() ? "branch crossing at " + at : given;
+    for (const std::size_t j : crossing_branches(branches, r.points, b)) {
+      if (named[j]) continue;  // it crossed at an earlier boundary too, and has that name
+      named[j] = true;
+      n.branches.push_back(j);
+    }
+    out.any_named = out.any_named || !n.branches.empty();
+    out.branches.push_back(n);
+  }
+  return out;
+}
+
+// The named branches as data blocks $branch_<boundary>_<m>: parameter, Re λ, Im λ (a gap where
+// a branch is not tracked).
+void write_branches(std::ostream& s, const std::vector<NamedBranch>& named_branches, const Branches& branches,
+                    const SweepResult& r) {
+  for (std::size_t i = 0; i < named_branches.size(); ++i)
+    for (std::size_t m = 0; m < named_branches[i].branches.size(); ++m) {
+      s << "$branch_" << i << "_" << m << " << EOD\n";
+      const auto& values = branches[named_branches[i].branches[m]];
+      for (std::size_t k = 0; k < values.size(); ++k) {
+        if (std::isnan(values[k].real())) {
+          s << "\n";
+          continue;
+        }
+        char line[128];
+        std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", r.points[k].value, values[k].real(), values[k].imag());
+        s << line;
+      }
+      s << "EOD\n";
+    }
+}
+
+// The eigenvalues against the parameter: real parts above, imaginary parts below, one legend for
+// both below them. Every label a gnuplot_string, every text literal (noenhanced).
 std::string sweep_script(const std::string& terminal, const SweepResult& r, const SweepPlot& plot) {
+  static const char* const kBranchColors[] = {"#d95f02", "#1b9e77", "#e7298a", "#66a61e", "#a6761d", "#e6ab02"};
+  constexpr std::size_t kColors = sizeof kBranchColors / sizeof kBranchColors[0];
+  const std::string parameter = plot.parameter.empty() ? r.parameter : plot.parameter;
   std::ostringstream s;
-  s << "set terminal " << terminal << "\n$sweep << EOD\n";
-  for (const SweepPoint& p : r.points)
-    for (const auto& l : p.eigenvalues) {
+  s << "set terminal " << terminal << "\nset termoption noenhanced\n";
+  const auto row = [&s](double x, double y, double z) {
+    char line[128];
+    std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", x, y, z);
+    s << line;
+  };
+  // The boundaries in order of the parameter, named by the user or by what crosses there, each
+  // with the branches that cross.
+  std::vector<const StabilityBoundary*> boundaries;
+  for (const StabilityBoundary& b : r.boundaries) boundaries.push_back(&b);
+  std::stable_sort(boundaries.begin(), boundaries.end(),
+                   [](const StabilityBoundary* a, const StabilityBoundary* b) { return a->value < b->value; });
+  const Branches branches = boundaries.empty() ? Branches{} : track_branches(r.points);
+  const BoundaryNames names = name_boundaries(boundaries, branches, r, plot, parameter);
+  const std::vector<std::string>& boundary_labels = names.labels;
+  const std::vector<NamedBranch>& named_branches = names.branches;
+  const bool any_named = names.any_named;
+  // The points not on a named branch, real and complex apart; the exact zeros as a line (a gap
+  // where there are none).
+  std::vector<std::vector<std::complex<double>>> on_branch(r.points.size());  // per point
+  for (const NamedBranch& n : named_branches)
+    for (const std::size_t j : n.branches)
+      for (std::size_t k = 0; k < r.points.size(); ++k) on_branch[k].push_back(branches[j][k]);
+  std::size_t real_count = 0, complex_count = 0, zeros_min = 0, zeros_max = 0, zero_points = 0;
+  std::ostringstream real_rows, complex_rows;
+  for (std::size_t k = 0; k < r.points.size(); ++k) {
+    const SweepPoint& p = r.points[k];
+    std::vector<std::complex<double>> skip = on_branch[k];
+    for (std::size_t i = p.zeros; i < p.eigenvalues.size(); ++i) {
+      const auto l = p.eigenvalues[i];
       if (!std::isfinite(l.real()) || !std::isfinite(l.imag())) continue;
+      const auto it = std::find(skip.begin(), skip.end(), l);
+      if (it != skip.end()) {
+        skip.erase(it);
+        continue;
+      }
+      const bool real = is_real(l);
+      std::ostringstream& rows = real ? real_rows : complex_rows;
+      ++(real ? real_count : complex_count);
       char line[128];
       std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", p.value, l.real(), l.imag());
-      s << line;
+      rows << line;
     }
-  s << "EOD\n"
-    << "set multiplot layout 2,1 title " << gnuplot_string(plot.title) << " noenhanced\n"
-    << "set grid xtics ytics\nunset key\n";
-  for (const StabilityBoundary& b : r.boundaries)
-    s << "set arrow from " << b.value << ", graph 0 to " << b.value << ", graph 1 nohead dt 2 lc rgb '#b03030'\n";
-  s << "set ylabel 'Re lambda [1/s]'\n"
-    << "plot $sweep using 1:2 with points pt 7 ps 0.4 lc rgb '#1f4e9c', 0 with lines lc rgb 'black'\n"
-    << "set ylabel 'Im lambda [1/s]'\nset xlabel " << gnuplot_string(plot.parameter_label) << " noenhanced\n"
-    << "plot $sweep using 1:3 with points pt 7 ps 0.4 lc rgb '#1f4e9c'\n"
-    << "unset multiplot\n";
+  }
+  s << "$real << EOD\n" << real_rows.str() << "EOD\n$complex << EOD\n" << complex_rows.str() << "EOD\n$zeros << EOD\n";
+  for (const SweepPoint& p : r.points) {
+    if (p.zeros == 0) {
+      s << "\n";
+      continue;
+    }
+    ++zero_points;
+    zeros_min = zeros_min == 0 ? p.zeros : std::min(zeros_min, p.zeros);
+    zeros_max = std::max(zeros_max, p.zeros);
+    row(p.value, 0, 0);
+  }
+  s << "EOD\n";
+  write_branches(s, named_branches, branches, r);
+
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const SweepPoint& p : r.points) {
+    lo = std::min(lo, p.value);
+    hi = std::max(hi, p.value);
+  }
+  s << "set multiplot title " << gnuplot_string(plot.title) << "\n"
+    << "set grid xtics ytics\nunset key\nset lmargin at screen 0.1\nset rmargin at screen 0.97\n";
+  if (hi > lo) s << "set xrange [" << format_number(lo, "%.17g") << ":" << format_number(hi, "%.17g") << "]\n";
+  // The stable intervals shaded, the boundaries as dashed lines, in both panels.
+  const std::vector<std::pair<double, double>> stable = stable_intervals(r);
+  std::string stable_label;
+  for (const auto& iv : stable) {
+    s << "set object rectangle from " << format_number(iv.first, "%.17g") << ", graph 0 to "
+      << format_number(iv.second, "%.17g") << ", graph 1 behind fillcolor rgb '#d9f0d3' fillstyle solid 1.0 noborder\n";
+    stable_label += (stable_label.empty() ? "stable: " : ", ") + format_number(iv.first, "%.4g") + "–" +
+                    with_unit(iv.second, plot.unit);
+  }
+  if (!stable_label.empty() && zeros_max > 0) stable_label += " (Re λ < 0 apart from the exact zeros)";
+  const auto color = [&](std::size_t i) { return std::string(kBranchColors[i % kColors]); };
+  for (std::size_t i = 0; i < boundaries.size(); ++i)
+    s << "set arrow from " << format_number(boundaries[i]->value, "%.17g") << ", graph 0 to "
+      << format_number(boundaries[i]->value, "%.17g") << ", graph 1 nohead front dashtype 2 linewidth 1.5 linecolor rgb '"
+      << color(i) << "'\n";
+
+  // The plot command of one panel (column 2: real parts, 3: imaginary parts); `titled`: with the
+  // legend's entries (the lower panel carries the legend of both).
+  const auto plot_command = [&](int column, bool titled) {
+    const auto title = [&](const std::string& t) { return titled ? " title " + gnuplot_string(t) : std::string(" notitle"); };
+    std::ostringstream c;
+    c << "plot ";
+    std::string sep;
+    if (!stable_label.empty()) {
+      c << "NaN with filledcurves y1=0 fillcolor rgb '#d9f0d3' fillstyle solid 1.0" << title(stable_label);
+      sep = ", ";
+    }
+    if (zeros_max > 0) {
+      const std::string count = zeros_min == zeros_max ? std::to_string(zeros_max)
+                                                      : std::to_string(zeros_min) + "–" + std::to_string(zeros_max);
+      c << sep << "$zeros using 1:" << column << " with lines linewidth 3 linecolor rgb '#9e9e9e'"
+        << title("structural zeros λ = 0 (×" + count + ", exact)");
+      sep = ", ";
+    }
+    if (real_count > 0) {
+      c << sep << "$real using 1:" << column << " with points pointtype 7 pointsize 0.45 linecolor rgb '#1f4e9c'"
+        << title(!any_named ? "real eigenvalues" : "other real eigenvalues");
+      sep = ", ";
+    }
+    if (complex_count > 0) {
+      c << sep << "$complex using 1:" << column << " with points pointtype 9 pointsize 0.6 linecolor rgb '#7b3294'"
+        << title(!any_named ? "complex pairs (oscillatory)" : "other complex pairs (oscillatory)");
+      sep = ", ";
+    }
+    for (std::size_t i = 0; i < named_branches.size(); ++i)
+      for (std::size_t m = 0; m < named_branches[i].branches.size(); ++m) {
+        c << sep << "$branch_" << i << "_" << m << " using 1:" << column << " with lines linewidth 3 linecolor rgb '"
+          << color(i) << "'" << (m == 0 ? title(named_branches[i].label) : std::string(" notitle"));
+        sep = ", ";
+      }
+    for (std::size_t i = 0; i < boundaries.size(); ++i) {
+      c << sep << "NaN with lines dashtype 2 linewidth 1.5 linecolor rgb '" << color(i) << "'" << title(boundary_labels[i]);
+      sep = ", ";
+    }
+    // The axis Re λ = 0 (Im λ = 0), unless the zeros' line is there at every point.
+    if (zero_points < r.points.size()) c << sep << "0 with lines linewidth 1 linecolor rgb 'black' notitle";
+    c << "\n";
+    return c.str();
+  };
+  // The panels above the legend, which takes a line an entry.
+  std::size_t entries = boundaries.size() + (stable_label.empty() ? 0 : 1) + (zeros_max > 0 ? 1 : 0) +
+                        (real_count > 0 ? 1 : 0) + (complex_count > 0 ? 1 : 0);
+  for (const NamedBranch& n : named_branches) entries += n.branches.empty() ? 0 : 1;
+  const double key = std::min(0.45, 0.024 * static_cast<double>(entries) + 0.02), bottom = key + 0.09;
+  const double panel = (0.94 - bottom - 0.07) / 2;
+  s << "set offsets 0, 0, graph 0.05, graph 0.05\n"
+    << "set tmargin at screen 0.94\nset bmargin at screen " << format_number(0.94 - panel, "%.4f") << "\n"
+    << "set ylabel 'Re λ [1/s]'\n" << plot_command(2, false)
+    << "set tmargin at screen " << format_number(bottom + panel, "%.4f") << "\nset bmargin at screen "
+    << format_number(bottom, "%.4f") << "\nset ylabel 'Im λ [1/s]'\n"
+    << "set xlabel " << gnuplot_string(plot.parameter_label) << "\n"
+    << "set key at screen 0.5, " << format_number(key, "%.4f")
+    << " center top vertical Left reverse samplen 2 spacing 1.1\n"
+    << plot_command(3, true) << "unset multiplot\n";
   return s.str();
 }
 
@@ -311,7 +648,7 @@ void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz, const E
 }
 
 void write_sweep_plot(const std::string& path, const SweepResult& r, const SweepPlot& plot) {
-  render(path, [&](const std::string& terminal) { return sweep_script(terminal, r, plot); });
+  render(path, [&](const std::string& terminal) { return sweep_script(terminal, r, plot); }, "900,900");
 }
 
 }  // namespace mbsgen::cli

@@ -31,10 +31,21 @@ void write_bode_plot(const std::string& path, const Eigen::VectorXd& hz,
 struct SweepPlot {
   std::string title;
   std::string parameter_label;  // e.g. "v [m/s]"
+  std::string parameter;        // e.g. "v" (empty: the sweep's), for labels "v = 4.292 m/s"
+  std::string unit;             // e.g. "m/s" ("" or "-": none)
+  /// Names of the stability boundaries in order of increasing parameter (e.g. "weave",
+  /// "capsize"); a boundary without one is named by what crosses there.
+  std::vector<std::string> boundary_names;
 };
 
-/// Writes the eigenvalues of a parameter sweep (real parts above, imaginary parts below, the
-/// stability boundaries as dashed vertical lines) to `path`, as write_bode_plot does.
+/// Writes the eigenvalues of a parameter sweep to `path`, as write_bode_plot does: real parts
+/// above, imaginary parts below, one legend for both. Real eigenvalues and complex pairs are
+/// marked apart, the solver's exact zeros (SweepPoint::zeros) drawn as one grey line, each
+/// stability boundary as a dashed vertical line named with its value and kind (oscillatory: a
+/// complex pair crosses, with its frequency; divergence: a real eigenvalue crosses) or with
+/// plot.boundary_names, the branch that crosses there (found by continuation) as a line of the
+/// same colour, and the intervals where every eigenvalue but the exact zeros has Re λ < 0 shaded
+/// and named "stable".
 void write_sweep_plot(const std::string& path, const SweepResult& result, const SweepPlot& plot);
 
 struct TimePlot {

@@ -48,6 +48,7 @@ struct Options {
   long points = 200;
   double from = 0, to = 0;
   std::string parameter;  ///< sweep
+  std::vector<std::string> boundary_names;  ///< sweep --plot: the boundaries' names, by increasing value
   std::vector<std::string> sensitivity;  ///< modes, frf: --sensitivity [PARAMETER…] (empty: all)
   bool sensitivity_given = false;
 };
@@ -247,7 +248,15 @@ int run_sweep(const ModelKernels& k, const Options& o, std::ostream& out, std::o
     plot.title = std::string(k.model) + " (" + k.scene + "): eigenvalues against " + o.parameter;
     const auto& names = model.parameter_names();
     const auto index = std::find(names.begin(), names.end(), o.parameter) - names.begin();
-    plot.parameter_label = o.parameter + " [" + unit_or(k.parameter_units, static_cast<int>(index), "-") + "]";
+    plot.parameter = o.parameter;
+    plot.unit = unit_or(k.parameter_units, static_cast<int>(index), "-");
+    plot.parameter_label = o.parameter + " [" + plot.unit + "]";
+    plot.boundary_names = o.boundary_names;
+    if (!o.boundary_names.empty() && o.boundary_names.size() != r.boundaries.size())
+      err << "sweep: " << o.boundary_names.size() << " boundary name" << (o.boundary_names.size() == 1 ? "" : "s")
+          << " for " << r.boundaries.size() << " stability boundar" << (r.boundaries.size() == 1 ? "y" : "ies")
+          << "; they name the boundaries in order of increasing " << o.parameter
+          << ", and a boundary without a name is named by its kind\n";
     write_sweep_plot(o.plot, r, plot);
     err << "wrote " << o.plot << "\n";
   }
@@ -453,7 +462,12 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   sweep->add_option("--points", o.points, "number of values, linear spacing (default 101)")
       ->check(CLI::Range(2L, kMaxFrequencyPoints));
   sweep->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json"}));
-  sweep->add_option("--plot", o.plot, "write the eigenvalues against the parameter (FILE.svg or FILE.png)");
+  CLI::Option* sweep_plot =
+      sweep->add_option("--plot", o.plot, "write the eigenvalues against the parameter (FILE.svg or FILE.png)");
+  sweep->add_option("--boundary-names", o.boundary_names,
+                    "names of the stability boundaries on the plot, in order of increasing parameter (e.g. weave,capsize)")
+      ->delimiter(',')
+      ->needs(sweep_plot);
   CLI::App* matrices = app.add_subcommand("matrices", "M, Q, K, B, C_y, C_v (C_a, D) at the operating point");
   add_set(matrices);
   matrices->add_option("--format", o.format, "json (standard output) or mtx (files in --out)")

@@ -32,12 +32,18 @@ SweepPoint spectrum(const GeneratedModel& model, double value) {
   p.value = value;
   p.stability = stability;
   p.abscissa = p.raw_abscissa = -std::numeric_limits<double>::infinity();
+  // The exact zeros first (both solvers sort them first already), counted.
   for (const Mode& m : modes) {
-    if (m.kind != EigenvalueKind::finite && m.kind != EigenvalueKind::zero) continue;
+    if (m.kind != EigenvalueKind::zero) continue;
+    p.eigenvalues.push_back(m.lambda);
+    ++p.zeros;
+  }
+  for (const Mode& m : modes) {
+    if (m.kind != EigenvalueKind::finite) continue;
     p.eigenvalues.push_back(m.lambda);
     // A real part within the eigenvalue's error bound counts as 0: the data do not tell its sign
     // (an undamped model's ±1e-16), so only a decided sign makes a boundary.
-    if (m.kind == EigenvalueKind::finite && !m.zero_within_bound) {
+    if (!m.zero_within_bound) {
       p.abscissa = std::max(p.abscissa, std::abs(m.lambda.real()) <= m.error_bound ? 0.0 : m.lambda.real());
       p.raw_abscissa = std::max(p.raw_abscissa, m.lambda.real());
     }

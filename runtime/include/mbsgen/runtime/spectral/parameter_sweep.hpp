@@ -7,6 +7,7 @@
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
 #include <complex>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,10 @@ struct SweepPoint {
   /// Finite eigenvalues (both members of a conjugate pair), in QuadraticEigenSolver's order:
   /// zeros first, then by increasing |λ|.
   std::vector<std::complex<double>> eigenvalues;
+  /// How many of the eigenvalues (the first ones) are exact zeros, kind zero: deflated by the
+  /// solver, not computed (a bicycle's ignorable heading and wheel angles). A finite eigenvalue
+  /// that merely rounds to 0 is not counted.
+  std::size_t zeros = 0;
   /// max Re λ over the finite eigenvalues that are not zero (deflated or within their error
   /// bound), a real part within its error bound counted as 0; −∞ when there is none. The model
   /// is unstable at this value when it is > 0.
