@@ -99,11 +99,11 @@ std::string bode_script(const std::string& terminal, const Eigen::VectorXd& hz, 
     << "set logscale x\nset grid xtics ytics mxtics\nset format x '10^{%L}'\n"
     << "set logscale y\nset format y '10^{%L}'\n"
     << "set ylabel " << gnuplot_string(plot.amplitude_label) << " noenhanced\n"
-    << "unset key\n"
-    << "plot $bode using 1:2 with lines lw 2 lc rgb '#1f4e9c'\n"
-    << "unset logscale y\nset format y '%g'\n"
+    << "set key top right box opaque noenhanced\n"  // each panel's one line named in a legend
+    << "plot $bode using 1:2 with lines lw 2 lc rgb '#1f4e9c' title " << gnuplot_string("magnitude " + plot.amplitude_label)
+    << "\nunset logscale y\nset format y '%g'\n"
     << "set ylabel 'phase lag [deg]'\nset xlabel 'frequency [Hz]'\n"
-    << "plot $bode using 1:3 with lines lw 2 lc rgb '#1f4e9c'\n"
+    << "plot $bode using 1:3 with lines lw 2 lc rgb '#1f4e9c' title 'phase lag [deg]'\n"
     << "unset multiplot\n";
   return s.str();
 }
@@ -580,11 +580,12 @@ std::string time_script(const std::string& terminal, const Eigen::VectorXd& t, c
   }
   s << "EOD\n"
     << "set multiplot layout " << values.rows() << ",1 title " << gnuplot_string(plot.title) << " noenhanced\n"
-    << "set grid xtics ytics\nunset key\n";
+    << "set grid xtics ytics\nset key top right box opaque noenhanced\n";
   for (Eigen::Index i = 0; i < values.rows(); ++i) {
     if (i + 1 == values.rows()) s << "set xlabel 'time [s]'\n";
-    s << "set ylabel " << gnuplot_string(plot.labels[static_cast<std::size_t>(i)]) << " noenhanced\n"
-      << "plot $series using 1:" << i + 2 << " with lines lw 2 lc rgb '#1f4e9c'\n";
+    const std::string label = gnuplot_string(plot.labels[static_cast<std::size_t>(i)]);
+    s << "set ylabel " << label << " noenhanced\n"
+      << "plot $series using 1:" << i + 2 << " with lines lw 2 lc rgb '#1f4e9c' title " << label << "\n";
   }
   s << "unset multiplot\n";
   return s.str();
