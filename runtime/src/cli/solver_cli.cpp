@@ -274,7 +274,8 @@ int run_sweep(const ModelKernels& k, const Options& o, std::ostream& out, std::o
     for (std::size_t i = 0; i < r.boundaries.size(); ++i) {
       const StabilityBoundary& b = r.boundaries[i];
       out << (i ? "," : "") << "{\"value\":" << num(b.value, true) << ",\"tolerance\":" << num(b.tolerance, true)
-          << ",\"becomes\":" << (b.becomes_unstable ? "\"unstable\"" : "\"stable\"") << ",\"eigenvalue\":["
+          << ",\"becomes\":" << (b.becomes_unstable ? "\"unstable\"" : "\"stable\"") << ",\"below\":\""
+          << to_string(b.below) << "\",\"above\":\"" << to_string(b.above) << "\",\"eigenvalue\":["
           << num(b.eigenvalue.real(), true) << "," << num(b.eigenvalue.imag(), true) << "]}";
     }
     out << "]}\n";
@@ -287,10 +288,16 @@ int run_sweep(const ModelKernels& k, const Options& o, std::ostream& out, std::o
           << pad(num(p.eigenvalues[j].imag(), false), 26) << "  " << to_string(p.stability) << "\n";
   for (const StabilityBoundary& b : r.boundaries)
     out << "# stability boundary: " << r.parameter << " = " << num(b.value, false) << " (+/- " << short_num(b.tolerance)
-        << "): " << (b.becomes_unstable ? "unstable" : "stable") << " above, eigenvalue "
+        << "): " << to_string(b.below) << " below, " << to_string(b.above) << " above, eigenvalue "
         << num(b.eigenvalue.real(), false) << " " << (b.eigenvalue.imag() < 0 ? "- " : "+ ")
         << num(std::abs(b.eigenvalue.imag()), false) << "i\n";
   if (r.boundaries.empty()) out << "# no stability boundary between " << num(o.from, false) << " and " << num(o.to, false) << "\n";
+  const auto undecided = std::count_if(r.points.begin(), r.points.end(),
+                                       [](const SweepPoint& p) { return p.stability == Stability::undecided; });
+  if (undecided > 0)
+    out << "# " << undecided << " of " << r.points.size()
+        << " values undecided (an eigenvalue within its error bound of zero or of the imaginary axis): a boundary is "
+           "placed only between decided verdicts, and its bracket contains the undecided values next to it\n";
   return 0;
 }
 

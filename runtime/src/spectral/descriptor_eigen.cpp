@@ -41,6 +41,7 @@
 #include <sstream>
 
 #include "spectral/dense_linear_algebra.hpp"
+#include "spectral/spectrum_structure.hpp"
 
 namespace mbsgen {
 
@@ -86,6 +87,17 @@ struct Raw {
   Eigen::VectorXcd x, y;
   double eta = 0.0;       // normwise backward error (reported)
   double eta_comp = 0.0;  // componentwise backward error (chooses the balancing)
+  // The eigenvectors and backward error the error bound is computed from: those of the reduced
+  // pencil when every deflation was exact (a structured bound, see Conditioning), else x, y, eta.
+  Eigen::VectorXcd cx, cy;
+  double ceta = 0.0;
+};
+
+/// The pencil an eigenvalue's condition is measured on, with its norm estimates.
+struct Conditioning {
+  const Eigen::MatrixXd& E;
+  const Eigen::MatrixXd& A;
+  double nE, nA;
 };
 
 /// Householder deflation of the exactly zero columns Z of a (sub-)pencil (file comment), once.
@@ -382,6 +394,13 @@ std::vector<Raw> qz(const Deflation& d, const Eigen::MatrixXd& E, const Eigen::M
     r.y = d.left(l, E.rows());
     r.eta = backward_error(E, A, r.alpha, r.beta, r.x, nE, nA);
     r.eta_comp = componentwise_backward_error(E, A, r.alpha, r.beta, r.x);
+    if (d.exact()) {
+      r.cx = w, r.cy = l;
+      r.ceta = backward_error(d.reduced_E(), d.reduced_A(), r.alpha, r.beta, w,
+                              detail::norm2_estimate(d.reduced_E()), detail::norm2_estimate(d.reduced_A()));
+    } else {
+      r.cx = r.x, r.cy = r.y, r.ceta = r.eta;
+    }
     out.push_back(std::move(r));
   }
   return out;
@@ -422,9 +441,12 @@ void sort_modes(std::vector<Mode>& modes) {
   }
 }
 
-/// Classifies a computed pair (class comment of DescriptorEigenSolver) and fills a Mode.
-Mode classify(Raw&& r, const Eigen::MatrixXd& E, const Eigen::MatrixXd& A, double nE, double nA,
-              double floor) {
+/// Classifies a computed pair (class comment of DescriptorEigenSolver) and fills a Mode. The
+/// condition numbers, the infinite test and the error bound use the pencil `c` with r.cx, r.cy,
+/// r.ceta: the reduced pencil after exact deflations (a structured bound: the deflated columns
+/// are exactly zero in the data, and perturbations that keep them zero move only the reduced
+/// pencil's eigenvalues), else the full pencil.
+Mode classify(Raw&& r, const Conditioning& c, double floor) {
   Mode md;
   md.alpha = r.alpha;
   md.beta = r.beta;
@@ -433,13 +455,15 @@ Mode classify(Raw&& r, const Eigen::MatrixXd& E, const Eigen::MatrixXd& A, doubl
   md.left_shape = std::move(r.y);
   normalize_shape(md.shape);
   normalize_shape(md.left_shape);
-  const Eigen::VectorXcd Ex = times(E, md.shape), Ax = times(A, md.shape);
-  const cd yEx = md.left_shape.dot(Ex), yAx = md.left_shape.dot(Ax);  // yᴴEx, yᴴAx
+  const double cx = r.cx.norm() * r.cy.norm();
+  const Eigen::VectorXcd Ex = times(c.E, r.cx), Ax = times(c.A, r.cx);
+  const cd yEx = r.cy.dot(Ex) / cx, yAx = r.cy.dot(Ax) / cx;  // yᴴEx, yᴴAx for unit x, y
   const double a = std::abs(md.alpha), b = md.beta;
-  const double eta = std::max(md.backward_error, floor);
+  const double eta = std::max(r.ceta, floor);
+  const double nE = c.nE, nA = c.nA;
   {
     const double num = std::sqrt(a * a * nE * nE + b * b * nA * nA);
-    const double den = std::abs(md.left_shape.dot(b * Ex + std::conj(md.alpha) * Ax));
+    const double den = std::abs(b * yEx + std::conj(md.alpha) * yAx);
     md.condition_homogeneous = den > 0 ? num / den : kInf;
   }
   // Infinite within bound: the reversed pencil's μ = β/α is zero within its error bound
@@ -569,6 +593,39 @@ std::vector<Mode> zero_modes(const Eigen::MatrixXd& E, const Eigen::MatrixXd& A,
   return out;
 }
 
+/// After exact deflations: when the reduced A is structurally rank deficient by k, λ = 0 is an
+/// eigenvalue of the reduced pencil at least k times for every value of its nonzero entries (a
+/// rolling disk's neighbouring steady turns, a conserved momentum). The k finite eigenvalues of
+/// least modulus are then that exact zero, provided each is zero within its error bound (else
+/// the computation contradicts the structure, and they are left as computed). Returns how many
+/// were made kind zero.
+Index structural_zeros(std::vector<Mode>& finite, const Eigen::MatrixXd& reduced_A) {
+  const Index k = reduced_A.rows() - detail::structural_rank(reduced_A);
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < finite.size(); ++i)
+    if (finite[i].kind == EigenvalueKind::finite) order.push_back(i);
+  if (k == 0 || static_cast<Index>(order.size()) < k) return 0;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return std::abs(finite[a].lambda) < std::abs(finite[b].lambda);
+  });
+  order.resize(static_cast<std::size_t>(k));
+  for (std::size_t i : order)
+    if (!finite[i].zero_within_bound) return 0;
+  for (std::size_t i : order) {
+    Mode& md = finite[i];
+    md.kind = EigenvalueKind::zero;
+    md.lambda = 0.0;
+    md.alpha = 0.0;
+    md.beta = 1.0;
+    md.natural_frequency_hz = md.damped_frequency_hz = 0.0;
+    md.damping_ratio = kNaN;
+    md.condition = kInf;
+    md.error_bound = 0.0;
+    md.zero_within_bound = false;
+  }
+  return k;
+}
+
 }  // namespace
 
 DescriptorEigenSolver::DescriptorEigenSolver(DescriptorEigenOptions options)
@@ -595,7 +652,7 @@ DescriptorEigenSolver& DescriptorEigenSolver::compute_named(
     const Eigen::MatrixXd& E, const Eigen::MatrixXd& A, const std::vector<std::string>& names) {
   info_ = Eigen::InvalidInput;
   modes_.clear();
-  num_zero_ = num_infinite_ = 0;
+  num_zero_ = num_infinite_ = num_structural_zero_ = 0;
   const Index n = E.rows();
   const double nE = detail::norm2_estimate(E), nA = detail::norm2_estimate(A);
   const double floor = options_.backward_error_floor > 0    ? options_.backward_error_floor
@@ -632,9 +689,19 @@ DescriptorEigenSolver& DescriptorEigenSolver::compute_named(
                                      : worst(alt) <= bar && worst(alt, true) < worst(finite, true);
       if (better) finite.swap(alt);
     }
+    const Conditioning cond = d.exact() ? Conditioning{d.reduced_E(), d.reduced_A(),
+                                                       detail::norm2_estimate(d.reduced_E()),
+                                                       detail::norm2_estimate(d.reduced_A())}
+                                        : Conditioning{E, A, nE, nA};
+    std::vector<Mode> rest;
     for (Raw& r : finite) {
-      Mode md = classify(std::move(r), E, A, nE, nA, floor);
-      if (md.kind == EigenvalueKind::infinite) ++num_infinite_;
+      rest.push_back(classify(std::move(r), cond, floor));
+      if (rest.back().kind == EigenvalueKind::infinite) ++num_infinite_;
+    }
+    num_structural_zero_ = d.exact() ? structural_zeros(rest, d.reduced_A()) : 0;
+    num_zero_ += num_structural_zero_;
+    if (d.exact() && detail::reversible_sign_pattern({{&d.reduced_E(), 1}, {&d.reduced_A(), -1}})) detail::snap_to_axis(rest);
+    for (Mode& md : rest) {
       if (options_.one_per_conjugate_pair && md.kind == EigenvalueKind::finite &&
           md.lambda.imag() < 0.0)
         continue;

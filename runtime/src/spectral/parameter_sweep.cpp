@@ -69,48 +69,64 @@ std::complex<double> rightmost(const SweepPoint& p) {
   return best;
 }
 
-// Whether the computed spectrum grows, by the signs of the real parts themselves (no error
-// bounds): an eigenvalue counts when |λ| exceeds 100·u of the largest (below that it is the
-// rounding of a zero, such as a rolling disk's neighbouring steady turn, whose normwise error
-// bound is no guide), and grows when Re λ > 0.
-bool grows(const SweepPoint& p) {
-  const double u = std::numeric_limits<double>::epsilon();
-  double scale = 0;
-  for (const auto& l : p.eigenvalues) scale = std::max(scale, std::abs(l));
-  for (const auto& l : p.eigenvalues)
-    if (std::abs(l) > 100 * u * scale && l.real() > 0) return true;
-  return false;
+// The decided verdict at a point: +1 unstable (an eigenvalue with Re λ > its error bound), −1
+// not unstable and decided (stable or marginal: every eigenvalue decided to lie left of or
+// exactly on the imaginary axis, zeros exact), 0 undecided (an eigenvalue within its bound of the
+// axis or of zero). Only decided verdicts make or bound a boundary.
+int verdict(const SweepPoint& p) {
+  if (p.abscissa > 0) return 1;
+  return p.stability == Stability::undecided ? 0 : -1;
 }
 
-// Bisection between a and b, whose decided signs differ, on grows(): within the error band the
-// computed sign is still the nearer one, so the crossing is found to about the eigenvalue's actual
-// error / |d Re λ/dp| instead of its bound's (a bicycle's capsize root near the crossing has a
-// normwise bound of 1e10, coupled to the heading's Jordan chain, and an error of 1e-13).
+// Bisection of [lo, hi] where `lo` has the decided verdict v and `hi` does not: the last point
+// with verdict v, to the sweep's tolerance.
+SweepPoint last_with(GeneratedModel& model, const std::string& parameter, int v, SweepPoint lo,
+                     SweepPoint hi, const SweepOptions& options) {
+  for (int i = 0; i < 200; ++i) {
+    if (std::abs(hi.value - lo.value) <= options.relative_tolerance * std::max(1.0, std::abs(lo.value)))
+      break;
+    SweepPoint mid = at(model, parameter, (lo.value + hi.value) / 2);
+    if (mid.value == lo.value || mid.value == hi.value) break;  // adjacent doubles
+    if (verdict(mid) == v) {
+      lo = std::move(mid);
+    } else {
+      hi = std::move(mid);
+    }
+  }
+  return lo;
+}
+
+// The boundary between a and b, whose decided verdicts differ (one unstable): the bracket from
+// the last point with a's verdict to the first with b's. Bisection narrows it while the midpoint
+// is decided; a midpoint whose verdict is undecided (the crossing eigenvalue within its bound of
+// the axis: a Jordan block at the crossing, the rolling disk's merging pair) splits the search,
+// and the bracket keeps the undecided band, since the data do not tell where in it the crossing
+// lies. So |value − crossing| ≤ tolerance whenever the verdicts are right.
 StabilityBoundary refine(GeneratedModel& model, const std::string& parameter, SweepPoint a, SweepPoint b,
                          const SweepOptions& options) {
-  const bool a_unstable = a.abscissa > 0;
-  // The decided verdicts (with error bounds) bracket the crossing only to the width of the band
-  // where the crossing eigenvalue is within its bound; the computed signs may change just outside
-  // the bracket (the bicycle's capsize root at 1,000 speeds). Widen by the bracket's width until
-  // the signs at its ends differ.
-  const double step = b.value - a.value;
-  for (int k = 0; k < 64 && grows(a) != a_unstable; ++k) a = at(model, parameter, a.value - step);
-  for (int k = 0; k < 64 && grows(b) == a_unstable; ++k) b = at(model, parameter, b.value + step);
+  const int va = verdict(a), vb = verdict(b);
   for (int i = 0; i < 200; ++i) {
-    const double width = std::abs(b.value - a.value);
-    if (width <= options.relative_tolerance * std::max(1.0, std::abs(a.value))) break;
-    const SweepPoint mid = at(model, parameter, (a.value + b.value) / 2);
-    if (grows(mid) == a_unstable) {
-      a = mid;
+    if (std::abs(b.value - a.value) <= options.relative_tolerance * std::max(1.0, std::abs(a.value))) break;
+    SweepPoint mid = at(model, parameter, (a.value + b.value) / 2);
+    if (mid.value == a.value || mid.value == b.value) break;
+    const int v = verdict(mid);
+    if (v == va) {
+      a = std::move(mid);
+    } else if (v == vb) {
+      b = std::move(mid);
     } else {
-      b = mid;
+      a = last_with(model, parameter, va, a, mid, options);
+      b = last_with(model, parameter, vb, b, mid, options);
+      break;
     }
   }
   StabilityBoundary s;
   s.value = (a.value + b.value) / 2;
   s.tolerance = std::abs(b.value - a.value) / 2;
-  s.becomes_unstable = (a.value < b.value) ? !a_unstable : a_unstable;
-  s.eigenvalue = rightmost(a_unstable ? a : b);
+  s.becomes_unstable = (a.value < b.value) ? vb > 0 : va > 0;
+  s.eigenvalue = rightmost(va > 0 ? a : b);
+  s.below = a.value < b.value ? a.stability : b.stability;
+  s.above = a.value < b.value ? b.stability : a.stability;
   return s;
 }
 
@@ -135,10 +151,12 @@ SweepResult sweep_parameter(GeneratedModel& model, const std::string& parameter,
       const double v = from + (to - from) * i / (points - 1);
       r.points.push_back(at(model, parameter, i == points - 1 ? to : v));
     }
-    for (std::size_t i = 1; i < r.points.size(); ++i) {
-      const SweepPoint &a = r.points[i - 1], &b = r.points[i];
-      if (std::isinf(a.abscissa) || std::isinf(b.abscissa)) continue;
-      if ((a.abscissa > 0) != (b.abscissa > 0)) r.boundaries.push_back(refine(model, parameter, a, b, options));
+    // Between neighbouring decided points (undecided ones skipped) whose verdicts differ.
+    const SweepPoint* last = nullptr;
+    for (const SweepPoint& p : r.points) {
+      if (verdict(p) == 0) continue;
+      if (last && verdict(*last) != verdict(p)) r.boundaries.push_back(refine(model, parameter, *last, p, options));
+      last = &p;
     }
   } catch (...) {
     model.set(parameter, saved);

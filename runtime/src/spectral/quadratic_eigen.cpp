@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "spectral/dense_linear_algebra.hpp"
+#include "spectral/spectrum_structure.hpp"
 
 namespace mbsgen {
 
@@ -175,6 +176,10 @@ QuadraticEigenSolver& QuadraticEigenSolver::compute(const Eigen::MatrixXd& M,
   if (options_.symmetric_fast_path && check.is_symmetric_undamped()) compute_symmetric(M, K, done);
   if (!done) compute_general(M, Qf, K);
   finish(M, Qf, K);
+  // An undamped (e.g. gyroscopic) system whose zero pattern makes its spectrum symmetric about
+  // the imaginary axis: isolated eigenvalues within their bounds of the axis are on it
+  // (spectrum_structure.hpp), so a sleeping top is marginal, not undecided.
+  if (detail::reversible_sign_pattern({{&M, 1}, {&Qf, -1}, {&K, 1}})) detail::snap_to_axis(modes_);
   stability_ = stability_of(modes_);
   info_ = Eigen::Success;
   return *this;

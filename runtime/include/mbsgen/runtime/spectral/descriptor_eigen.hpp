@@ -51,6 +51,19 @@ struct DescriptorEigenOptions {
 ///    same test on the reversed pencil E − μA: |μ| ≤ (‖E‖ + |μ|‖A‖)‖x‖‖y‖/|yᴴAx|·max(η, η_floor).
 ///    This includes β = 0 exactly (QZ sets β to 0 below u‖E‖) and rounding-split Jordan chains
 ///    at ∞ (higher-index descriptor systems).
+///    After exact deflations (permutations only) the bound is structured: κ, η and the infinite
+///    test are those of the reduced pencil, whose eigenvalues are the full pencil's other than
+///    the deflated zeros for every perturbation that keeps the deflated exact zeros zero. (The
+///    full pencil's normwise bound of a reduced eigenvalue that is coupled to an ignorable
+///    coordinate's Jordan chain — a rolling disk's steady turn and its heading — is 1e20.)
+/// 3. Structural zeros: when the reduced A (exact deflations) has structural rank m − k, λ = 0 is
+///    an eigenvalue at least k times for every value of the data; the k finite eigenvalues of
+///    least modulus, each zero within its bound, are reported as kind zero (λ = 0, bound 0).
+/// 4. Symmetric spectra: when a signature R makes R E R = E and R A R = −A on the reduced pencil's
+///    sign pattern (exact deflations; an undamped system, even positions and odd speeds), its
+///    spectrum is symmetric about the imaginary axis for every value of the data, so a finite
+///    eigenvalue within its bound of the axis whose error disk meets no other eigenvalue's is on
+///    the axis exactly: its real part is reported as 0 (a marginal verdict, not undecided).
 /// Norms are ‖·‖₂ lower estimates (so η errs on the large side). Cost: O(n³), about 66n³ flops
 /// for QZ with both eigenvector sets, twice when 'B' is tried.
 class DescriptorEigenSolver {
@@ -74,8 +87,11 @@ class DescriptorEigenSolver {
   /// left null space, and condition_homogeneous is +∞.
   const std::vector<Mode>& modes() const { return modes_; }
   /// Number of exactly zero eigenvalues (deflated zero columns of A and of the exactly reduced
-  /// pencils).
+  /// pencils, and the structural zeros of the reduced pencil, see num_structural_zero()).
   Eigen::Index num_zero() const { return num_zero_; }
+  /// Of num_zero(), those from the structural rank of the reduced A (item 3 of the class
+  /// comment): zero for every value of the data, found by QZ within their error bounds.
+  Eigen::Index num_structural_zero() const { return num_structural_zero_; }
   /// Number of eigenvalues classified infinite (counted also when one_per_conjugate_pair).
   Eigen::Index num_infinite() const { return num_infinite_; }
   /// Stability verdict with the rules of QuadraticEigenSolver (see Stability).
@@ -94,7 +110,7 @@ class DescriptorEigenSolver {
   Eigen::ComputationInfo info_ = Eigen::InvalidInput;
   std::vector<Mode> modes_;
   std::vector<Eigen::Index> zero_columns_;
-  Eigen::Index num_zero_ = 0, num_infinite_ = 0;
+  Eigen::Index num_zero_ = 0, num_infinite_ = 0, num_structural_zero_ = 0;
   Stability stability_ = Stability::undecided;
 };
 

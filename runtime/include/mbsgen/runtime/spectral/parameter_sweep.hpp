@@ -31,12 +31,21 @@ struct SweepPoint {
   Stability stability = Stability::stable;
 };
 
-/// A value where the largest real part crosses zero: the model turns unstable (or stable) there.
+/// A value where the model turns unstable (or stops being unstable), found only between two
+/// decided verdicts (Stability: unstable on one side, stable or marginal on the other; undecided
+/// points never make a boundary).
 struct StabilityBoundary {
-  double value = 0;           ///< the parameter value, refined by bisection
-  double tolerance = 0;       ///< |value − true crossing| ≤ tolerance (bisection bracket)
+  double value = 0;  ///< the middle of the bracket below
+  /// Half the bracket from the last parameter value with one decided verdict to the first with
+  /// the other, refined by bisection: |value − true crossing| ≤ tolerance as long as the verdicts
+  /// (which respect every eigenvalue's error bound) are right. Where the crossing eigenvalue is
+  /// within its bound of the axis over a band (a Jordan block at the crossing, e.g. a rolling
+  /// disk's merging lean pair), the band stays inside the bracket.
+  double tolerance = 0;
   bool becomes_unstable = true;  ///< in the direction of increasing parameter
-  std::complex<double> eigenvalue;  ///< the eigenvalue with the largest real part there
+  std::complex<double> eigenvalue;  ///< the eigenvalue with the largest real part, unstable side
+  Stability below = Stability::stable;  ///< the verdict at the bracket's lower end
+  Stability above = Stability::stable;  ///< the verdict at the bracket's upper end
 };
 
 struct SweepResult {
@@ -52,8 +61,9 @@ struct SweepOptions {
 
 /// Sets `parameter` of `model` to `points` values from `from` to `to` (linear spacing, both ends;
 /// points ≥ 2), finds the operating point (Newton for an equilibrium) and the eigenvalues of the
-/// linear model at each, and refines every change of sign of the spectral abscissa between
-/// neighbouring values by bisection. The model's parameter is restored afterwards. Throws
+/// linear model at each, and refines every change between the decided verdicts of neighbouring
+/// decided values (unstable against stable or marginal; undecided values skipped) by bisection
+/// (StabilityBoundary). The model's parameter is restored afterwards. Throws
 /// NameError for an unknown parameter, Error for points < 2 or a non-finite range, and what the
 /// model's analyses throw at a value (the message names the value).
 SweepResult sweep_parameter(GeneratedModel& model, const std::string& parameter, double from, double to,
