@@ -769,6 +769,7 @@ DescriptorFrf descriptor_frequency_response(const DescriptorModel& model,
   out.rcond.resize(F);
   out.flags.assign(static_cast<std::size_t>(F), FrfFlag::ok);
   const double pole_rc = static_cast<double>(n) * kU;  // FrfOptions::pole_rcond's default
+  const Eigen::MatrixXd minus_a = -A;  // for frf_scaled_rcond at a failing point
   const double ill_rc = 1e-8;                          // FrfOptions::ill_conditioned_rcond's
   const lapack_int nn = detail::li(n);
   Eigen::MatrixXcd G(n, n);
@@ -803,12 +804,23 @@ DescriptorFrf descriptor_frequency_response(const DescriptorModel& model,
     }
     out.rcond[k] = rc;
     FrfFlag flag = FrfFlag::ok;
-    if (!ok || !(rc > pole_rc) || !out.response.col(k).allFinite())
-      flag = FrfFlag::pole;
+    const bool finite = ok && out.response.col(k).allFinite();
+    if (finite && !out.response.col(k).cwiseAbs().allFinite())  // |re + i im| beyond the range
+      flag = FrfFlag::overflow;
+    else if (!finite || !(rc > pole_rc))  // a pole unless the system scaled to unit size is not
+      flag = frf_scaled_rcond(Eigen::MatrixXd(), E, minus_a, om) > pole_rc ? FrfFlag::overflow : FrfFlag::pole;
     else if (rc < ill_rc)
       flag = FrfFlag::ill_conditioned;
     out.flags[static_cast<std::size_t>(k)] = flag;
-    if (flag == FrfFlag::pole) {
+    if (flag == FrfFlag::overflow) {
+      if (on_pole == PoleHandling::raise) {
+        std::ostringstream s;
+        s << who << ": the range of double is exceeded at Ω = " << om
+          << " rad/s (iΩE − A, the solution or an output overflows): rescale the model's units";
+        throw NonFiniteError(s.str());
+      }
+      out.response.col(k).setConstant(cd(kNaN, kNaN));
+    } else if (flag == FrfFlag::pole) {
       if (on_pole == PoleHandling::raise) {
         std::ostringstream s;
         s << who << ": iΩE − A is singular at Ω = " << om << " rad/s, rcond = " << rc

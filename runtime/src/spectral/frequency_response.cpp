@@ -5,6 +5,8 @@
 // frf_real.cpp; Impl is declared in frequency_response_impl.hpp.
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
 
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -108,8 +110,27 @@ const char* to_string(FrfFlag flag) {
     case FrfFlag::ok: return "ok";
     case FrfFlag::ill_conditioned: return "ill_conditioned";
     case FrfFlag::pole: return "pole";
+    case FrfFlag::overflow: return "overflow";
   }
   return "?";
+}
+
+double frf_scaled_rcond(const Eigen::MatrixXd& X2, const Eigen::MatrixXd& X1, const Eigen::MatrixXd& X0,
+                        double omega) {
+  using ld = long double;  // 64-bit mantissa, exponent to ±4932 on x86-64 and AArch64
+  const Index n = X0.rows();
+  const ld w = omega;
+  auto largest = [](const Eigen::MatrixXd& X) { return X.size() ? static_cast<ld>(X.cwiseAbs().maxCoeff()) : 0.0L; };
+  const ld s = std::max({w * w * largest(X2), w * largest(X1), largest(X0)});
+  if (!(s > 0)) return 0.0;
+  Eigen::MatrixXcd G(n, n);
+  for (Index j = 0; j < n; ++j)
+    for (Index i = 0; i < n; ++i) {
+      const ld re = (X2.size() ? -w * w * X2(i, j) : 0.0L) + X0(i, j);
+      const ld im = w * X1(i, j);
+      G(i, j) = cd(static_cast<double>(re / s), static_cast<double>(im / s));
+    }
+  return Eigen::PartialPivLU<Eigen::MatrixXcd>(G).rcond();
 }
 
 // ---- FrequencyResponse::Impl: the members every method shares ----
@@ -261,6 +282,7 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
     const std::vector<FrfFlag> flags = flags_;
     const Eigen::VectorXd rcond = rcond_;
     auto worst = [](FrfFlag a, FrfFlag b) {
+      if (a == FrfFlag::overflow || b == FrfFlag::overflow) return FrfFlag::overflow;
       if (a == FrfFlag::pole || b == FrfFlag::pole) return FrfFlag::pole;
       return a == FrfFlag::ill_conditioned || b == FrfFlag::ill_conditioned ? FrfFlag::ill_conditioned : FrfFlag::ok;
     };
@@ -282,7 +304,7 @@ FrequencyResponse& FrequencyResponse::compute(const Eigen::VectorXd& omega, Inde
         merged[K] = worst(merged[K], flags_[K]);
         merged_rcond[k] = std::min(merged_rcond[k], rcond_[k]);
         const cd factor = part == 1 ? cd(0.0, omega[k]) : cd(-omega[k] * omega[k], 0.0);
-        if (merged[K] == FrfFlag::pole)
+        if (merged[K] == FrfFlag::pole || merged[K] == FrfFlag::overflow)
           response_.col(k).setConstant(cd(kNaN, kNaN));
         else
           response_.col(k) += factor * z.col(k);
@@ -327,12 +349,25 @@ void FrequencyResponse::sweep(const Eigen::VectorXd& omega, FrfMethod m, Index p
     // `real` solves the squared system Ω²E + A², whose rcond is about the square of the complex
     // one's: a small rcond there says the real 2f×2f solve is ill-conditioned, not that Ω is a
     // pole; a pole is an exact zero pivot or a non-finite value.
-    if (!ok || !im.z.allFinite() || (!(rc > pole_rc) && m != FrfMethod::real))
-      flag = FrfFlag::pole;
+    const bool finite = ok && im.z.allFinite();
+    if (finite && !im.z.head(p).cwiseAbs().allFinite())  // |re + i im| beyond the range
+      flag = FrfFlag::overflow;
+    else if (!finite || (!(rc > pole_rc) && m != FrfMethod::real))
+      // A pole, unless the system scaled to unit size is not singular: then the data or the
+      // value left the range of double (an rcond of 3e-2 or 1 is no pole).
+      flag = frf_scaled_rcond(model_.M(), model_.Q(), model_.K(), om) > pole_rc ? FrfFlag::overflow : FrfFlag::pole;
     else if (rc < options_.ill_conditioned_rcond)
       flag = FrfFlag::ill_conditioned;
     flags_[static_cast<std::size_t>(k)] = flag;
-    if (flag == FrfFlag::pole) {
+    if (flag == FrfFlag::overflow) {
+      if (options_.on_pole == PoleHandling::raise) {
+        std::ostringstream s;
+        s << "FrequencyResponse::compute (" << to_string(m) << "): the range of double is exceeded at "
+          << hz(om) << " (the dynamic stiffness, the solution or an output overflows): rescale the model's units";
+        throw NonFiniteError(s.str());
+      }
+      out.col(k).setConstant(cd(kNaN, kNaN));
+    } else if (flag == FrfFlag::pole) {
       if (options_.on_pole == PoleHandling::raise) {
         std::ostringstream s;
         s << "FrequencyResponse::compute (" << to_string(m) << "): the system is singular at "

@@ -288,6 +288,8 @@ bool FrequencyResponse::Impl::hessenberg_solution(double om, Eigen::VectorXcd& y
   Eigen::VectorXd xr = reduced_rhs(), xi = Eigen::VectorXd::Zero(N);
   double rc = 0.0;
   if (!hsolver.solve(H, hess_standard ? nullptr : &T, om, xr, xi, rc)) return false;
+  // An overflowed solve (data near the largest double): LAPACKE would refuse its NaNs below.
+  if (!xr.allFinite() || !xi.allFinite()) return false;
   X << xr, xi;
   if (hess_standard) {
     const lapack_int info = LAPACKE_dormhr(LAPACK_COL_MAJOR, 'L', 'N', NN, 2, hilo, hihi,

@@ -59,9 +59,19 @@ enum class FrfFlag : unsigned char {
   ill_conditioned,
   /// exactly singular (zero pivot), a non-finite value, or (except `real`) rcond ≤ pole_rcond:
   /// no correct digits; value NaN
-  pole
+  pole,
+  /// the range of double was exceeded at this frequency: an entry of the dynamic stiffness
+  /// −Ω²M + iΩQ + K (iΩE − A) overflows, or the solve or an output (or its modulus) does although
+  /// the system is not singular; value NaN. Not a pole: rescale the model's units.
+  overflow
 };
-/// "ok", "ill_conditioned", "pole".
+/// "ok", "ill_conditioned", "pole", "overflow".
+/// The reciprocal condition (1-norm estimate) of −Ω²X2 + iΩX1 + X0 (X2 may be empty) assembled in
+/// extended range and scaled by its largest term's size to unit norm before the LU, so that data
+/// near the ends of the range of double (entries of 1e308 or 1e-307) neither overflow nor make the
+/// estimate underflow: what tells a pole (≈ 0) from a point whose value only overflows.
+double frf_scaled_rcond(const Eigen::MatrixXd& X2, const Eigen::MatrixXd& X1, const Eigen::MatrixXd& X0,
+                        double omega);
 const char* to_string(FrfFlag flag);
 
 /// Options of FrequencyResponse.
