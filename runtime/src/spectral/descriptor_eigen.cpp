@@ -650,6 +650,14 @@ double DescriptorEigenSolver::max_backward_error() const {
 
 DescriptorEigenSolver& DescriptorEigenSolver::compute_named(
     const Eigen::MatrixXd& E, const Eigen::MatrixXd& A, const std::vector<std::string>& names) {
+  // Data near the ends of the range of double: the exactly scaled pencil (spectrum_structure.hpp),
+  // λE − A with λ = γμ: coefficients −A (λ⁰) and E (λ¹).
+  auto largest = [](const Eigen::MatrixXd& X) { return X.size() ? X.cwiseAbs().maxCoeff() : 0.0; };
+  if (const detail::RangeScaling sc = detail::range_scaling({largest(A), largest(E)}); sc.active) {
+    compute_named(sc.scaled(E, 1), sc.scaled(A, 0), names);
+    detail::unscale_modes(modes_, sc.gamma());
+    return *this;
+  }
   info_ = Eigen::InvalidInput;
   modes_.clear();
   num_zero_ = num_infinite_ = num_structural_zero_ = 0;

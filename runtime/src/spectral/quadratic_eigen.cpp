@@ -140,6 +140,10 @@ double QuadraticEigenSolver::max_backward_error() const {
   return e;
 }
 
+namespace {
+double largest_entry(const Eigen::MatrixXd& X) { return X.size() ? X.cwiseAbs().maxCoeff() : 0.0; }
+}  // namespace
+
 QuadraticEigenSolver& QuadraticEigenSolver::compute(const Eigen::MatrixXd& M,
                                                     const Eigen::MatrixXd& Q,
                                                     const Eigen::MatrixXd& K) {
@@ -150,6 +154,14 @@ QuadraticEigenSolver& QuadraticEigenSolver::compute(const Eigen::MatrixXd& M,
   const LinearModel check(M, Q.size() == 0 ? Eigen::MatrixXd::Zero(M.rows(), M.rows()) : Q, K,
                           Eigen::MatrixXd(M.rows(), 0), Eigen::MatrixXd(), Eigen::MatrixXd());
   const Eigen::MatrixXd& Qf = check.Q();
+  // Data near the ends of the range of double (1e±135 and beyond): solve the exactly scaled
+  // problem (powers of two) and scale its eigenvalues back (spectrum_structure.hpp).
+  if (const detail::RangeScaling sc = detail::range_scaling({largest_entry(K), largest_entry(Qf), largest_entry(M)});
+      sc.active) {
+    compute(sc.scaled(M, 2), sc.scaled(Qf, 1), sc.scaled(K, 0));
+    detail::unscale_modes(modes_, sc.gamma());
+    return *this;
+  }
   const Eigen::Index n = M.rows();
   const double rank_tol =
       options_.rank_tolerance > 0 ? options_.rank_tolerance : static_cast<double>(n) * kU;

@@ -1,10 +1,12 @@
 // Spectral facts from zero patterns (spectrum_structure.hpp).
 #include "spectral/spectrum_structure.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <cstddef>
 #include <functional>
+#include <limits>
 
 namespace mbsgen::detail {
 
@@ -98,6 +100,57 @@ Eigen::Index snap_to_axis(std::vector<Mode>& modes) {
     md.damping_ratio = 0.0;
   }
   return static_cast<Index>(on_axis.size());
+}
+
+double RangeScaling::gamma() const { return std::ldexp(1.0, k); }
+
+Eigen::MatrixXd RangeScaling::scaled(const Eigen::MatrixXd& X, int j) const {
+  const int p = j * k + e;
+  return X.unaryExpr([p](double x) { return std::ldexp(x, p); });
+}
+
+RangeScaling range_scaling(const std::vector<double>& largest) {
+  constexpr int kBand = 450;
+  RangeScaling r;
+  std::vector<int> ex(largest.size(), 0);
+  bool any = false;
+  for (std::size_t j = 0; j < largest.size(); ++j) {
+    if (!(largest[j] > 0)) continue;
+    std::frexp(largest[j], &ex[j]);
+    any = true;
+    if (std::abs(ex[j]) > kBand) r.active = true;
+  }
+  if (!any || !r.active) return RangeScaling{};
+  // γ from the highest and lowest present coefficients: 2^(e_0 − e_d)/d.
+  std::size_t lo = largest.size(), hi = 0;
+  for (std::size_t j = 0; j < largest.size(); ++j)
+    if (largest[j] > 0) {
+      lo = std::min(lo, j);
+      hi = std::max(hi, j);
+    }
+  r.k = hi > lo ? static_cast<int>(std::lround(static_cast<double>(ex[lo] - ex[hi]) / static_cast<double>(hi - lo))) : 0;
+  int top = std::numeric_limits<int>::min();
+  for (std::size_t j = 0; j < largest.size(); ++j)
+    if (largest[j] > 0) top = std::max(top, ex[j] + static_cast<int>(j) * r.k);
+  r.e = -top;
+  return r;
+}
+
+void unscale_modes(std::vector<Mode>& modes, double gamma) {
+  for (Mode& m : modes) {
+    if (m.kind != EigenvalueKind::finite) continue;
+    m.lambda *= gamma;
+    m.natural_frequency_hz *= gamma;
+    m.damped_frequency_hz *= gamma;
+    m.error_bound *= gamma;
+    // (α, β) of λ = α/β: α·γ, renormalized (|α|² + β² = 1).
+    const std::complex<double> a = m.alpha * gamma;
+    const double s = std::hypot(std::abs(a), m.beta);
+    if (s > 0 && std::isfinite(s)) {
+      m.alpha = a / s;
+      m.beta /= s;
+    }
+  }
 }
 
 }  // namespace mbsgen::detail

@@ -32,4 +32,22 @@ bool reversible_sign_pattern(const std::vector<std::pair<const Eigen::MatrixXd*,
 /// its damping ratio to 0. Returns how many were.
 Eigen::Index snap_to_axis(std::vector<Mode>& modes);
 
+/// Exact scaling by powers of two for data near the ends of the range of double (entries beyond
+/// 2^±450 ≈ 1e±135, where norms that square entries overflow or underflow): λ = γμ with
+/// γ = 2^k balancing the highest and lowest coefficients, and every coefficient times 2^e so that
+/// the largest entry is about 1. Coefficient j (of λ^j) is multiplied by 2^(j·k + e): exact unless
+/// an entry becomes subnormal. active is false for data inside the band (nothing changes there).
+struct RangeScaling {
+  bool active = false;
+  int k = 0, e = 0;
+  double gamma() const;
+  /// Coefficient j of the scaled problem.
+  Eigen::MatrixXd scaled(const Eigen::MatrixXd& X, int j) const;
+};
+/// From the largest absolute entries of the coefficients of λ⁰, λ¹, (λ²) (zero: absent).
+RangeScaling range_scaling(const std::vector<double>& largest);
+/// Undoes the λ-scaling on modes computed from the scaled problem: λ, α, the frequencies and the
+/// error bound times γ (the relative quantities, vectors and backward errors are unchanged).
+void unscale_modes(std::vector<Mode>& modes, double gamma);
+
 }  // namespace mbsgen::detail

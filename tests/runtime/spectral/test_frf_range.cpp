@@ -12,6 +12,7 @@
 #include "mbsgen/runtime/model/linear_model.hpp"
 #include "mbsgen/runtime/spectral/descriptor_eigen.hpp"
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
+#include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
 namespace {
 
@@ -92,6 +93,41 @@ TEST(FrfRange, DescriptorValueBeyondTheRangeIsOverflow) {
   const mbsgen::DescriptorFrf r = mbsgen::descriptor_frequency_response(d, w, 0);
   for (int k = 0; k < 2; ++k) EXPECT_EQ(r.flags[static_cast<std::size_t>(k)], FrfFlag::overflow) << k;
   EXPECT_TRUE(std::isnan(r.response(0, 0).real()));
+}
+
+// Eigenvalues of data at the ends of the range (before: an error bound of inf and the verdict
+// zero_within_bound for λ = 1.22i; `-` for λ = 1e300 i; "null_space: LAPACK dormqr rejected
+// argument 7" for a 2×2 of 1e308s). Solved exactly scaled by powers of two: λ² = −K/M in closed
+// form, to a few ulps, with a relative bound of rounding size.
+TEST(ModesRange, ExtremeScalesKeepTheirEigenvaluesAndBounds) {
+  struct Case {
+    double m, k;
+  };
+  for (const Case& c : {Case{1e308, 1.5e308}, Case{1e-300, 1e300}, Case{1e-200, 1e-250}, Case{4e300, 1e-300}}) {
+    mbsgen::QuadraticEigenSolver solver(1);
+    solver.compute(one(c.m), one(0), one(c.k));
+    ASSERT_EQ(solver.modes().size(), 2u);
+    const double w = static_cast<double>(std::sqrt(static_cast<long double>(c.k) / c.m));
+    for (const mbsgen::Mode& md : solver.modes()) {
+      EXPECT_EQ(md.kind, mbsgen::EigenvalueKind::finite);
+      EXPECT_FALSE(md.zero_within_bound) << c.m;
+      EXPECT_NEAR(std::abs(md.lambda.imag()), w, 4e-16 * w) << c.m;
+      EXPECT_LE(md.error_bound, 1e-12 * w) << c.m;
+    }
+    EXPECT_EQ(solver.stability(), mbsgen::Stability::marginal) << c.m;
+  }
+  Eigen::MatrixXd M(2, 2);
+  M << 1e308, 1e308, 1e308, 1.7e308;  // K = M: λ = ±i twice
+  mbsgen::QuadraticEigenSolver solver(2);
+  solver.compute(M, Eigen::MatrixXd::Zero(2, 2), M);
+  for (const mbsgen::Mode& md : solver.modes()) EXPECT_NEAR(std::abs(md.lambda.imag()), 1.0, 1e-12);
+  // The descriptor solver: E = 1e-300, A = −1e300: λ = −1e600 is beyond the range... so A = −1e-10,
+  // E = 1e-300: λ = −1e290.
+  mbsgen::DescriptorEigenSolver d;
+  d.compute(one(1e-300), one(-1e-10));
+  ASSERT_EQ(d.modes().size(), 1u);
+  EXPECT_NEAR(d.modes()[0].lambda.real(), -1e290, 4e-16 * 1e290);
+  EXPECT_EQ(d.stability(), mbsgen::Stability::stable);
 }
 
 }  // namespace
