@@ -184,9 +184,98 @@ std::string dependency(const Model& model, Equations& eq, const std::vector<RawE
          ") are linearly dependent (or zero)";
 }
 
+// A double as an exact rational (so that it does not lower the precision of 50-digit floats).
+GiNaC::numeric exact(double x) {
+  int e = 0;
+  const double m = std::frexp(x, &e);
+  const auto mantissa = static_cast<long long>(std::ldexp(m, 53));
+  return GiNaC::numeric(mantissa) * GiNaC::numeric(2).power(e - 53);
+}
+
+// A dependent equation may be dropped only where it holds: within this fraction of its size (a
+// length, or 1), the tolerance of a `given` operating point's closure (check_closure). Where the
+// equations kept hold to rounding (1e-15 of their size, after the projection below), a truly
+// redundant equation holds to rounding too; a contradiction (a pin and a rod of nonzero length)
+// leaves a residual of the mechanism's own size.
+constexpr double kConsistencyTolerance = 1e-8;
+
+// Moves `point` onto the equations kept (keep[k]) by minimum-norm Gauss–Newton steps in all the
+// coordinates (evaluations in 50 digits, steps in double); true when they close to 1e-12 of
+// their sizes, with the values there in `at`. False when it does not converge (a pseudo-random
+// start far from the constraint manifold) or the equations cannot be evaluated on the way.
+bool project(Equations& eq, const std::vector<RawEquation>& raw, const ExMatrix& Phi_y, const std::vector<char>& keep,
+             GiNaC::exmap& point, Numbers& at) {
+  std::vector<Eigen::Index> rows;
+  for (std::size_t k = 0; k < raw.size(); ++k)
+    if (keep[k]) rows.push_back(static_cast<Eigen::Index>(k));
+  try {
+    for (int iteration = 0; iteration < 30; ++iteration) {
+      at = evaluate(eq, raw, Phi_y, point);
+      MatrixXd J(static_cast<Eigen::Index>(rows.size()), at.J.cols());
+      Eigen::VectorXd phi(static_cast<Eigen::Index>(rows.size()));
+      bool closed = true;
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        const auto k = static_cast<std::size_t>(rows[i]);
+        J.row(static_cast<Eigen::Index>(i)) = at.J.row(rows[i]);
+        phi(static_cast<Eigen::Index>(i)) = at.phi[k];
+        closed = closed && std::abs(at.phi[k]) <= 1e-12 * std::max(at.size[k], 1e-300);
+      }
+      if (closed) return true;
+      const Eigen::VectorXd dy = J.completeOrthogonalDecomposition().solve(phi);
+      if (!dy.allFinite()) return false;
+      for (std::size_t j = 0; j < eq.y.size(); ++j)
+        point[eq.y[j]] = point[eq.y[j]] - exact(dy(static_cast<Eigen::Index>(j)));
+    }
+  } catch (const std::runtime_error&) {
+    return false;
+  }
+  return false;
+}
+
+// The kept equations that dropped equation k depends on: the rows of a least-squares
+// combination of the kept gradients that gives k's gradient at the point of J (pseudo-random:
+// at a closed point a contradicting rod's gradient vanishes).
+std::string partners(const std::vector<RawEquation>& raw, const std::vector<char>& keep, const MatrixXd& J, std::size_t k) {
+  std::vector<Eigen::Index> rows;
+  for (std::size_t i = 0; i < raw.size(); ++i)
+    if (keep[i]) rows.push_back(static_cast<Eigen::Index>(i));
+  MatrixXd A(J.cols(), static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) A.col(static_cast<Eigen::Index>(i)) = J.row(rows[i]).transpose();
+  const Eigen::VectorXd c = A.completeOrthogonalDecomposition().solve(J.row(static_cast<Eigen::Index>(k)).transpose());
+  const double cmax = c.size() ? c.cwiseAbs().maxCoeff() : 0.0;
+  std::string out;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (cmax > 0 && std::abs(c(static_cast<Eigen::Index>(i))) > 1e-8 * cmax)
+      out += (out.empty() ? "" : ", ") + describe(raw[static_cast<std::size_t>(rows[i])].equation);
+  return out;
+}
+
+// Throws unless each dropped equation holds at `at` (a point where the kept ones hold).
+void check_consistent(const Model& model, const std::vector<RawEquation>& raw, const std::vector<char>& keep,
+                      const MatrixXd& J_random, const Numbers& at, const std::string& where_text) {
+  for (std::size_t k = 0; k < raw.size(); ++k) {
+    const double tol = kConsistencyTolerance * at.size[k];
+    if (keep[k] || std::abs(at.phi[k]) <= tol) continue;
+    const bool positional = raw[k].size2 != 1;
+    const Constraint& c = constraint_named(model, raw[k].equation.constraint);
+    const std::string with = partners(raw, keep, J_random, k);
+    throw ModelError(c.where, "constraint " + describe(raw[k].equation) +
+                                  (with.empty() ? " cannot hold: its gradient vanishes in every configuration"
+                                                : " contradicts " + with + ": its gradient depends on theirs in every "
+                                                  "configuration, but where they hold it does not") +
+                                  " (residual " + format(at.phi[k]) + (positional ? " m" : "") + " " + where_text +
+                                  ", tolerance " + format(tol) + (positional ? " m" : "") +
+                                  "); the constraints cannot hold together: remove or correct one");
+  }
+}
+
 // Drops equations that are redundant for every configuration (the rank is deficient at a
-// pseudo-random point as well); a rank deficiency at the operating point only is a singular
-// position, an error.
+// pseudo-random point as well) and hold where the others do (at the operating point closed onto
+// the equations kept, and at two pseudo-random points, parameters included, closed the same
+// way); a dependent equation that does not hold there is an error naming the constraints and the
+// residual. A rank deficiency at the operating point only is a singular position, an error. An
+// equation whose gradient is identically zero is dropped as identically satisfied (its reaction
+// is zero, unique); the others make the reaction forces not unique.
 void drop_redundant(const Model& model, Equations& eq, std::vector<RawEquation>& raw, ExMatrix& Phi_y,
                     const Numbers& at_op, LoopClosure& loops) {
   const Eigen::Index rank = rank_of(at_op.J);
@@ -208,18 +297,39 @@ void drop_redundant(const Model& model, Equations& eq, std::vector<RawEquation>&
   qr.setThreshold(kRankTolerance);
   std::vector<char> keep(raw.size(), 0);
   for (Eigen::Index i = 0; i < rank; ++i) keep[static_cast<std::size_t>(qr.colsPermutation().indices()(i))] = 1;
+  // The dropped equations must hold where the kept ones do.
+  GiNaC::exmap point = operating_point_values(model, eq);
+  Numbers at;
+  if (!project(eq, raw, Phi_y, keep, point, at))
+    throw ModelError(model.operating_point().where.line ? model.operating_point().where : first.where,
+                     "the constraints cannot be closed near the operating point with the default parameter values "
+                     "(Newton's method on " + what + " does not converge)");
+  check_consistent(model, raw, keep, elsewhere.J, at, "at the operating point closed onto the others");
+  for (int sample = 0; sample < 2; ++sample) {
+    GiNaC::exmap p = sample == 0 ? random : detail::random_point({&eq.y, &eq.yd, &eq.u, &eq.p}, state);
+    if (project(eq, raw, Phi_y, keep, p, at))
+      check_consistent(model, raw, keep, elsewhere.J, at,
+                       "at a pseudo-random configuration and pseudo-random parameter values: with the defaults "
+                       "they hold together, with others they do not");
+  }
   std::vector<RawEquation> kept;
   ExMatrix kept_J;
   for (std::size_t k = 0; k < raw.size(); ++k) {
     if (keep[k]) {
       kept.push_back(raw[k]);
       kept_J.push_back(Phi_y[k]);
+      continue;
+    }
+    const bool constant = all_proved_zero(eq.program, Phi_y[k].size(), [&](std::size_t j) { return Phi_y[k][j]; });
+    if (constant) {
+      loops.dropped.push_back({raw[k].equation, "identically satisfied (its gradient is zero and it holds at the "
+                                                "operating point and at pseudo-random parameter values)"});
     } else {
       loops.dropped.push_back({raw[k].equation, "redundant in every configuration (" + what +
                                                     "); the reaction forces are not unique"});
+      loops.redundant = true;
     }
   }
-  loops.redundant = true;
   raw = std::move(kept);
   Phi_y = std::move(kept_J);
 }
@@ -295,14 +405,6 @@ void choose_coordinates(const Model& model, const MatrixXd& J, LoopClosure& loop
   loops.dependent = dependent;
   for (std::size_t j = 0; j < n; ++j)
     if (!std::binary_search(dependent.begin(), dependent.end(), j)) loops.independent.push_back(j);
-}
-
-// A double as an exact rational (so that it does not lower the precision of 50-digit floats).
-GiNaC::numeric exact(double x) {
-  int e = 0;
-  const double m = std::frexp(x, &e);
-  const auto mantissa = static_cast<long long>(std::ldexp(m, 53));
-  return GiNaC::numeric(mantissa) * GiNaC::numeric(2).power(e - 53);
 }
 
 // The dependent coordinates at the operating point with the default parameter values, closed to
@@ -466,10 +568,13 @@ LoopClosure close_loops(const Model& model, Equations& eq) {
                                                                 "operating point with the default parameter values (") +
                                                         e.what() + ")");
   }
-  check_closure(model, raw, at_op);
   drop_redundant(model, eq, raw, Phi_y, at_op, loops);
+  if (raw.empty())
+    throw ModelError(model.constraints().front().where,
+                     "every constraint equation is identically satisfied: the constraints do not restrict the motion");
   // The equations kept, at the operating point again (their sizes for the kernels' checks).
   const Numbers kept = evaluate(eq, raw, Phi_y, operating_point_values(model, eq));
+  check_closure(model, raw, kept);
   const MatrixXd& J = kept.J;
   for (std::size_t k = 0; k < raw.size(); ++k) {
     raw[k].equation.scale = kept.size[k];

@@ -2,6 +2,7 @@
 // choice of independent coordinates, and the errors for singular, redundant and badly given
 // constraints. Models are built with the C++ API and evaluated in process (50 digits).
 #include "mbsgen/generator/linear/linearize.hpp"
+#include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include "loop_models.hpp"
 
@@ -245,6 +246,91 @@ TEST(LoopClosure, RevoluteJointInSpaceLeavesOneSwing) {
   EXPECT_EQ(m.coordinates()[lin.coordinates[0]].name, "a");
   const double mgd = 1.2 * 9.81 * 0.4, md2 = 1.2 * 0.16;
   EXPECT_NEAR(value(eq, lin, lin.K[0][0]) / value(eq, lin, lin.M[0][0]) / (mgd / (0.03 + md2)), 1, 1e-14);
+}
+
+// The four-bar of models/linkages/four_bar.yaml with its pin's markers lifted out of the plane by
+// the same height written two ways (√2·√3 and √6): the pin's z equation is zero, its gradient
+// is proved zero, but the equation itself is not proved zero. It is identically satisfied and
+// its reaction is zero: dropped without the warning that the reactions are not unique (issue 39
+// §1; before, "redundant in every configuration … not unique").
+std::string four_bar_text(const std::string& z_coupler, const std::string& z_rocker) {
+  return R"(model: lifted
+parameters: {g: 9.81, a: 0.4, l1: 0.1, l2: 0.35, l3: 0.25, m: 0.3}
+coordinates: [th1, th2, th3]
+bodies:
+  - {name: crank, rotation: [{z: th1}], mass: m, com: [l1/2, 0, 0], inertia: {yy: m*l1^2/12, zz: m*l1^2/12}}
+  - name: coupler
+    parent: crank
+    translation: [l1, 0, 0]
+    rotation: [{z: th2}]
+    mass: m
+    com: [l2/2, 0, 0]
+    inertia: {yy: m*l2^2/12, zz: m*l2^2/12}
+    markers: [{name: coupler_end, position: [l2, 0, )" + z_coupler + R"(]}]
+  - name: rocker
+    translation: [a, 0, 0]
+    rotation: [{z: th3}]
+    mass: m
+    com: [l3/2, 0, 0]
+    inertia: {yy: m*l3^2/12, zz: m*l3^2/12}
+    markers: [{name: rocker_tip, position: [l3, 0, )" + z_rocker + R"(]}]
+forces: [{type: gravity, g: [0, -g, 0]}]
+constraints: [{name: pin, type: revolute, between: [coupler_end, rocker_tip]}]
+independent_coordinates: [th1]
+operating_point: {type: equilibrium, position: {th1: 1.0, th2: -0.45, th3: 1.95}}
+)";
+}
+
+TEST(LoopClosure, ZeroGradientEquationThatHoldsIsNotARedundancy) {
+  Model m = read_model_string(four_bar_text("sqrt(2)*sqrt(3)", "sqrt(6)"), "lifted.yaml");
+  Equations eq = derive(m);
+  EXPECT_FALSE(eq.loops.redundant);
+  ASSERT_EQ(eq.loops.equations.size(), 2u);
+  bool z_dropped = false;
+  for (const auto& [e, why] : eq.loops.dropped) {
+    EXPECT_EQ(why.find("not unique"), std::string::npos) << e.component << ": " << why;
+    if (e.component == "z") z_dropped = why.rfind("identically satisfied", 0) == 0;
+  }
+  EXPECT_TRUE(z_dropped);
+}
+
+// A dependent equation is dropped only where it holds; the pin's z rows that differ by 1 cm can
+// never hold: an error naming the constraint and the residual (tests/data/bad_models has the
+// complete messages of the contradictions).
+TEST(LoopClosure, ZeroGradientEquationThatCannotHoldIsRefused) {
+  const std::string e = error_of([&] {
+    Model m = read_model_string(four_bar_text("0.01", "0"), "lifted.yaml");
+    derive(m);
+  });
+  EXPECT_NE(e.find("constraint 'pin' (z) cannot hold: its gradient vanishes in every configuration (residual -0.01 m "
+                   "at the operating point closed onto the others"),
+            std::string::npos)
+      << e;
+}
+
+// A rod and an expression constraint that say the same thing (x² + y² = L²): consistent, so the
+// second is dropped as redundant, with the warning that the reactions are not unique, and the
+// pendulum is the simple pendulum (ω² = g/L for the bob of mass m at L, 1e-14: 50 digits).
+TEST(LoopClosure, ConsistentRedundantConstraintIsStillAccepted) {
+  Model m = read_model_string(R"(model: twice
+parameters: {g: 9.81, L: 0.7, m: 1.3}
+coordinates: [x, y]
+bodies: [{name: bob, translation: [x, y, 0], mass: m, markers: [{name: bob_point}]}]
+markers: [{name: pivot}]
+forces: [{type: gravity, g: [0, -g, 0]}]
+constraints:
+  - {name: rod, type: distance, between: [pivot, bob_point], length: L}
+  - {name: circle, type: expression, expression: (x^2 + y^2 - L^2)/(2*L)}
+independent_coordinates: [x]
+operating_point: {type: given, position: {x: 0, y: -L}}
+)",
+                              "twice.yaml");
+  Equations eq = derive(m);
+  EXPECT_TRUE(eq.loops.redundant);
+  ASSERT_EQ(eq.loops.dropped.size(), 1u);
+  EXPECT_EQ(eq.loops.dropped[0].first.constraint, "circle");
+  EXPECT_NE(eq.loops.dropped[0].second.find("the reaction forces are not unique"), std::string::npos);
+  EXPECT_NEAR(omega2(m) / (9.81 / 0.7), 1, 1e-14);
 }
 
 }  // namespace
