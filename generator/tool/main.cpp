@@ -48,6 +48,33 @@ void print_loops(const mbsgen::Model& model, const mbsgen::LoopClosure& loops) {
   if (loops.redundant) std::cout << "  the reaction forces are not unique (redundant constraints)\n";
 }
 
+// Nonholonomic constraints (rolling wheels, velocity constraints): their equations, the
+// independent speeds and those that follow, and the reduced second-order form's coordinates.
+void print_nonholonomic(const mbsgen::Model& model, const mbsgen::Nonholonomic& nh, const mbsgen::LinearEquations& lin) {
+  if (!nh.active) return;
+  auto names = [&](const std::vector<std::size_t>& v) {
+    std::string s;
+    for (std::size_t k : v) s += " " + model.coordinates()[k].name + "_dot";
+    return s.empty() ? std::string(" (none)") : s;
+  };
+  std::cout << "nonholonomic constraints: " << nh.equations.size() << " velocity equations\n  equations:";
+  for (const auto& e : nh.equations) std::cout << " " << e.constraint << (e.component.empty() ? "" : "." + e.component);
+  std::cout << "\n  independent speeds ("
+            << (nh.chosen ? "chosen by mbsgen: column-pivoted QR of the constraints' speed matrix at the operating point"
+                          : "listed in the model")
+            << "):" << names(nh.speeds) << "\n  dependent speeds:" << names(nh.dependent_speeds) << "\n";
+  if (!lin.descriptor) return;
+  std::cout << "  linear model: descriptor E x' = A x in (independent coordinates, independent speeds)\n";
+  std::cout << "  reduced second-order form: ";
+  if (!lin.reduced.exists) {
+    std::cout << "none (the coordinates are coupled to the speeds beyond a closed block)\n";
+    return;
+  }
+  std::cout << lin.reduced.coordinates.size() << " coordinates:";
+  for (std::size_t k : lin.reduced.coordinates) std::cout << " " << model.coordinates()[k].name;
+  std::cout << "\n";
+}
+
 int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& scenes,
                const mbsgen::Equations& eq, const mbsgen::LinearEquations& lin, const mbsgen::GeneratedCode& code,
                double seconds) {
@@ -72,6 +99,7 @@ int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& sce
   for (const auto& c : model.coordinates()) std::cout << " " << c.name;
   std::cout << "\n";
   print_loops(model, eq.loops);
+  print_nonholonomic(model, eq.nonholonomic, lin);
   std::cout << "inputs (" << model.inputs().size() << "):";
   for (const auto& i : model.inputs()) std::cout << " " << i.name << (i.motion ? " (motion)" : "");
   std::cout << "\noutputs (" << model.outputs().size() << "):";

@@ -1,5 +1,6 @@
 #include "mbsgen/generator/model/model.hpp"
 
+#include "mbsgen/generator/model/escape.hpp"
 #include "mbsgen/generator/model/scene.hpp"
 
 #include "model/smoothness_checks.hpp"
@@ -7,6 +8,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <limits>
@@ -103,6 +105,11 @@ void Model::check_new_symbol(const std::string& name, const SourceLocation& wher
 void Model::check_new_element(const std::string& name, const char* kind,
                               const SourceLocation& where) {
   if (name.empty()) throw ModelError(where, std::string("a ") + kind + " needs a name");
+  // The identifier rule of parameters and coordinates (check_new_symbol): one word everywhere.
+  if (!std::isalpha(static_cast<unsigned char>(name[0])) ||
+      !std::all_of(name.begin(), name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
+    throw ModelError(where, std::string("a ") + kind + " name must be a letter, then letters, digits and _: " +
+                                "'" + cpp_comment_text(name) + "' is not");
   if (name == kWorld) throw ModelError(where, "'world' is reserved for the inertial frame");
   auto it = element_names_.find(name);
   if (it != element_names_.end())

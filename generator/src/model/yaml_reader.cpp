@@ -509,8 +509,10 @@ std::string describe(const YAML::Node& n) {
   switch (n.Type()) {
     case YAML::NodeType::Null: return "nothing";
     case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
-    case YAML::NodeType::Sequence: return "a list";
-    case YAML::NodeType::Map: return "a map";
+    case YAML::NodeType::Sequence:
+      return n.size() == 0 ? "an empty list"
+                           : "a list of " + std::to_string(n.size()) + (n.size() == 1 ? " entry" : " entries");
+    case YAML::NodeType::Map: return n.size() == 0 ? "an empty map" : "a map";
     case YAML::NodeType::Undefined: break;
   }
   return "nothing";
@@ -729,10 +731,21 @@ class Reader {
     return n.Scalar();
   }
 
+  // A name of the model (a body, coordinate, marker, force, constraint, output, input, scene):
+  // an identifier, as the names of parameters and coordinates (Model::check_new_symbol), so that
+  // it is one word in every message, file name, column header and plot legend.
   std::string name(const Entry& e, const std::string& what) const {
     const YAML::Node& n = value(e);
     const std::string s = scalar(n, what);
     if (s.empty()) fail(n, what + " may not be empty");
+    if (!is_identifier(s)) {
+      const bool printable = std::all_of(s.begin(), s.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
+      const std::string shown = "'" + (printable ? s : cpp_comment_text(s)) + "'";
+      const std::string kind = what.rfind("an ", 0) == 0 ? what.substr(3) : what.rfind("a ", 0) == 0 ? what.substr(2) : what;
+      fail(n, shown + " is not a valid " + kind +
+                  (std::isalpha(static_cast<unsigned char>(s[0])) ? " (letters, digits and _)"
+                                                                  : " (a letter, then letters, digits and _)"));
+    }
     return s;
   }
 
@@ -1514,8 +1527,13 @@ void Reader::read_reduced_form(const Entry& e) {
                            text + "'");
     c.matrix = matrix[0];
     if (slash != std::string::npos) {
+      // A node made from the text has no place in the file: errors are placed at the part's value.
       const YAML::Node monomial(text.substr(slash + 1));
-      c.monomial = expr(monomial, "a reduced-form monomial", Scope::parameters);
+      try {
+        c.monomial = expr(monomial, "a reduced-form monomial", Scope::parameters);
+      } catch (const ModelError& error) {
+        fail(it->second, error.message() + " (in the reduced-form part '" + text + "')");
+      }
     }
     for (const auto& other : out)
       if (other.name == c.name) fail(it->first, "reduced-form matrix '" + c.name + "' is named twice");

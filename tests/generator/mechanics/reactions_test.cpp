@@ -4,6 +4,7 @@
 #include "mbsgen/generator/linear/linearize.hpp"
 #include "mbsgen/generator/mechanics/reactions.hpp"
 #include "mbsgen/generator/model/scene.hpp"
+#include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include "loop_models.hpp"
 
@@ -332,6 +333,64 @@ TEST(Reactions, SceneProbesOnlyTheLoadsItAsksFor) {
   ASSERT_EQ(scene.outputs.size(), 1u);
   const std::map<std::string, double> y{{"q1", 0.3}, {"q2", 0.2}}, yd{}, ydd{{"q2", 1.5}};
   EXPECT_NEAR(output(scene, 0, y, yd, ydd), output(full, 1, y, yd, ydd), 1e-13);
+}
+
+// Two pendulums on their own pivots geared by an `expression` constraint th3 = 2 th1 (issue 39
+// §1): the constraint's generalized force Φ_yᵀ λ acts through the coordinates it names, like an
+// actuator in each of their joints, so it is part of those joints' loads: each joint carries the
+// whole torque its pendulum needs (λ Φ_th3 = λ on B's, and, where the motion obeys the dynamics,
+// λ Φ_th1 = −2 λ on A's), and no force beyond its pendulum's own (a geometric loop would add the
+// loop's force there). Against Newton–Euler by hand for point masses on fixed pivots:
+// F = m r̈ − m g, τ = (r − p) × F, r̈ = l α (−s, c) − l ω² (c, s).
+TEST(Reactions, ExpressionConstraintActsThroughTheJointsOfItsCoordinates) {
+  const double g = 9.81, mA = 1.5, lA = 0.6, mB = 0.7, lB = 0.4;
+  const Model m = read_model_string(R"(model: geared
+parameters: {g: 9.81, mA: 1.5, lA: 0.6, mB: 0.7, lB: 0.4, a: 1.0}
+coordinates: [th1, th3]
+bodies:
+  - {name: A, rotation: [{z: th1}], mass: mA, com: [lA, 0, 0]}
+  - {name: B, translation: [a, 0, 0], rotation: [{z: th3}], mass: mB, com: [lB, 0, 0]}
+forces:
+  - {type: gravity, g: [0, -g, 0]}
+constraints:
+  - {name: gear, type: expression, expression: th3 - 2*th1}
+independent_coordinates: [th1]
+outputs:
+  - {name: A_fx, type: reaction, of: A, direction: [1, 0, 0]}
+  - {name: A_fy, type: reaction, of: A, direction: [0, 1, 0]}
+  - {name: A_tz, type: reaction, of: A, direction: [0, 0, 1], quantity: torque}
+  - {name: B_fx, type: reaction, of: B, direction: [1, 0, 0]}
+  - {name: B_fy, type: reaction, of: B, direction: [0, 1, 0]}
+  - {name: B_tz, type: reaction, of: B, direction: [0, 0, 1], quantity: torque}
+  - {name: gear_lambda, type: reaction, of: gear, direction: [1, 0, 0]}
+operating_point: {type: given, position: {th1: 0.3, th3: 0.6}}
+)",
+                                    "geared.yaml");
+  Equations eq = derive(m);
+  const double th1 = 0.3, th3 = 0.6, w1 = 0.5, w3 = 2 * w1;
+  auto load = [&](double mass, double l, double th, double w, double alpha, double out[3]) {
+    const double c = std::cos(th), s = std::sin(th);
+    const double ax = l * (-alpha * s - w * w * c), ay = l * (alpha * c - w * w * s);
+    out[0] = mass * ax;
+    out[1] = mass * ay + mass * g;
+    out[2] = l * (c * out[1] - s * out[0]);
+  };
+  // An arbitrary acceleration, and the one of the dynamics: τ_A + 2 τ_B = 0 (the gear does no work).
+  const double dynamic = -(mA * g * lA * std::cos(th1) + 2 * mB * g * lB * std::cos(th3)) / (mA * lA * lA + 4 * mB * lB * lB);
+  for (const double alpha1 : {0.7, dynamic}) {
+    double A[3], B[3];
+    load(mA, lA, th1, w1, alpha1, A);
+    load(mB, lB, th3, w3, 2 * alpha1, B);
+    const std::map<std::string, double> y{{"th1", th1}, {"th3", th3}}, yd{{"th1", w1}, {"th3", w3}},
+        ydd{{"th1", alpha1}};
+    const double expected[7] = {A[0], A[1], A[2], B[0], B[1], B[2], B[2]};
+    // 1e-13: loads of order 10 N (N m) evaluated in 50 digits against the closed form in double.
+    for (std::size_t i = 0; i < 7; ++i)
+      EXPECT_NEAR(output(eq, i, y, yd, ydd), expected[i], 1e-13) << m.outputs()[i].name << " alpha " << alpha1;
+    if (alpha1 == dynamic) {  // the gear's generalized force on th1 is all A's joint carries
+      EXPECT_NEAR(output(eq, 2, y, yd, ydd), -2 * output(eq, 6, y, yd, ydd), 1e-13);
+    }
+  }
 }
 
 }  // namespace
