@@ -409,7 +409,7 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   std::cerr << "mbsgen run: this mbsgen was built without the runtime (MBSGEN_BUILD_RUNTIME=OFF)\n";
   return 1;
 #else
-  const std::string text = read_file(model_file);  // throws: reported by the caller, exit 1
+  const std::string text = read_model_text(model_file);  // throws: reported by the caller, exit 1
   const Toolchain tc = toolchain();
   // `simulate` needs the kernels of a time step (EmitOptions::dynamics: the dynamics Jacobian);
   // the other commands' solver is built without them, as they cost compile time.

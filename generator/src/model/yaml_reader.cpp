@@ -11,8 +11,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -21,6 +23,10 @@
 #include <sstream>
 #include <utility>
 #include <vector>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace mbsgen {
 
@@ -1685,16 +1691,51 @@ Model read_model_string(const std::string& text, const std::string& file_name) {
   return Reader(text, file_name).read();
 }
 
-Model read_model_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw ModelError({path, 0, 0}, "is a directory, not a model file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ModelError({path, 0, 0}, "cannot open the model file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ModelError({path, 0, 0}, "cannot read the model file");
-  return read_model_string(text.str(), path);
+std::string read_model_text(const std::string& path) {
+  // Non-blocking open and fstat on the same descriptor: a FIFO, a device (/dev/zero), a socket or
+  // a directory is refused before a byte is read; 64 MiB at most (the largest model shipped is
+  // 30 kB).
+  constexpr std::size_t kMax = std::size_t{64} << 20;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) throw ModelError({path, 0, 0}, std::string("cannot open the model file: ") + std::strerror(errno));
+  struct stat st {};
+  const bool stat_ok = ::fstat(fd, &st) == 0;
+  if (!stat_ok || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    const char* kind = S_ISDIR(st.st_mode)    ? "a directory"
+                       : S_ISFIFO(st.st_mode) ? "a FIFO (named pipe)"
+                       : S_ISCHR(st.st_mode)  ? "a character device"
+                       : S_ISBLK(st.st_mode)  ? "a block device"
+                       : S_ISSOCK(st.st_mode) ? "a socket"
+                                              : "not a regular file";
+    throw ModelError({path, 0, 0}, stat_ok ? std::string("is ") + kind + ", not a model file (a regular file)"
+                                           : "cannot inspect the model file");
+  }
+  if (static_cast<unsigned long long>(st.st_size) > kMax) {
+    ::close(fd);
+    throw ModelError({path, 0, 0}, "is " + std::to_string(st.st_size) + " bytes; a model file may have at most " +
+                                       std::to_string(kMax) + " bytes");
+  }
+  std::string text;
+  char buf[65536];
+  for (;;) {
+    const ssize_t r = ::read(fd, buf, sizeof buf);
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) {
+      ::close(fd);
+      throw ModelError({path, 0, 0}, "cannot read the model file");
+    }
+    if (r == 0) break;
+    text.append(buf, static_cast<std::size_t>(r));
+    if (text.size() > kMax) {
+      ::close(fd);
+      throw ModelError({path, 0, 0}, "grew beyond " + std::to_string(kMax) + " bytes while being read");
+    }
+  }
+  ::close(fd);
+  return text;
 }
+
+Model read_model_file(const std::string& path) { return read_model_string(read_model_text(path), path); }
 
 }  // namespace mbsgen

@@ -36,6 +36,22 @@ inline CLI::Validator frequency_hz() {
       },
       "HZ", "frequency_hz");
 }
+/// A command-line number that must be finite and within [lo, hi] (lo excluded when lo_open):
+/// `nan`, `inf`, 1e400 and out-of-range values are usage errors (exit 2) whose message states the
+/// range as written in `range` (never DBL_MAX written out).
+inline CLI::Validator finite_in(double lo, double hi, bool lo_open, const std::string& range) {
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(text, &used);
+          if (used == text.size() && std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi) return "";
+        } catch (const std::exception&) {
+        }
+        return "'" + text + "' is not " + range;
+      },
+      "NUMBER", "finite_in");
+}
 /// The most frequencies a sweep may have (--points of both command lines): a sweep keeps its
 /// results in memory (about 100 bytes a point) before printing them (about 100 bytes a line).
 inline constexpr long kMaxFrequencyPoints = 1'000'000;

@@ -159,15 +159,21 @@ void print_statistics(std::ostream& err, const SimulateOptions& o, const Simulat
 CLI::App* add_simulate(CLI::App& app, SimulateOptions& o) {
   CLI::App* s = app.add_subcommand("simulate", "integrate the nonlinear equations of motion in time");
   s->add_option("--set", o.set, "set a parameter, NAME=VALUE (SI units); repeatable");
-  s->add_option("--duration", o.duration, "simulated time [s]")->required()->check(CLI::PositiveNumber);
-  s->add_option("--step", o.step, "output sampling [s] (default: duration / 1000)")->check(CLI::PositiveNumber);
+  s->add_option("--duration", o.duration, "simulated time [s]")->required()->check(
+      finite_in(0, 1e300, true, "a duration in seconds (a finite number > 0)"));
+  s->add_option("--step", o.step, "output sampling [s] (default: duration / 1000)")
+      ->check(finite_in(0, 1e300, true, "a time step in seconds (a finite number > 0)"));
   s->add_option("--initial", o.initial, "initial coordinate or rate, NAME=VALUE or NAME_dot=VALUE; repeatable "
                                         "(default: the operating point)");
   s->add_option("--input", o.inputs, "an input against time, NAME=VALUE, NAME=sine:AMPLITUDE,HZ[,PHASE_DEG[,OFFSET]], "
                                      "NAME=step:AMPLITUDE[,TIME[,BEFORE]], NAME=chirp:AMPLITUDE,F0,F1[,DURATION] or "
                                      "NAME=table:FILE.csv (t,value lines); repeatable (default: 0)");
-  s->add_option("--rtol", o.rtol, "relative tolerance")->check(CLI::PositiveNumber);
-  s->add_option("--atol", o.atol, "absolute tolerance")->check(CLI::PositiveNumber);
+  // 100 ε: below it no integrator here can meet the tolerance (Radau's Newton iteration stops at
+  // 10 ε / rtol; BDF reports "too much accuracy requested" after a long run).
+  s->add_option("--rtol", o.rtol, "relative tolerance, in [2.2e-14, 1]")
+      ->check(finite_in(2.2e-14, 1.0, false, "a relative tolerance in [2.2e-14, 1] (100 machine epsilons to 1)"));
+  s->add_option("--atol", o.atol, "absolute tolerance")
+      ->check(finite_in(0, 1e300, true, "an absolute tolerance (a finite number > 0)"));
   s->add_option("--atol-of", o.atol_of, "the absolute tolerance of one coordinate or rate, NAME=VALUE or "
                                         "NAME_dot=VALUE, in its units (states of different sizes); repeatable");
   s->add_option("--method", o.method, "bdf (stiff models; the default), radau (Radau IIA of order 5: stiff and "

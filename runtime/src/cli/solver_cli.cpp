@@ -464,8 +464,8 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   CLI::App* sweep = app.add_subcommand("sweep", "eigenvalues against a parameter, and where the stability changes");
   add_set(sweep);
   sweep->add_option("--parameter", o.parameter, "the parameter swept")->required();
-  sweep->add_option("--from", o.from, "first value (SI)")->required();
-  sweep->add_option("--to", o.to, "last value (SI)")->required();
+  sweep->add_option("--from", o.from, "first value (SI)")->required()->check(finite_in(-1e300, 1e300, false, "a finite number"));
+  sweep->add_option("--to", o.to, "last value (SI)")->required()->check(finite_in(-1e300, 1e300, false, "a finite number"));
   sweep->add_option("--points", o.points, "number of values, linear spacing (default 101)")
       ->check(CLI::Range(2L, kMaxFrequencyPoints));
   sweep->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json"}));

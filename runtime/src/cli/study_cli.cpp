@@ -144,7 +144,10 @@ std::vector<SobolResult> sobol_of(const Study& s) {
 // A table cell: left-aligned in w characters, one space after.
 std::string cell(const std::string& s, std::size_t w) { return s.size() >= w ? s + " " : s + std::string(w - s.size() + 1, ' '); }
 
+// NaN (a statistic of no values: every evaluation failed, or one value for an sd) is "-", never
+// printed as a number; the summary says why below its table.
 std::string fixed(double v, const char* format) {
+  if (std::isnan(v)) return "-";
   char b[64];
   std::snprintf(b, sizeof b, format, v);
   return b;
@@ -161,6 +164,7 @@ void write_summary(std::ostream& out, const Study& s, const std::vector<SobolRes
       << fixed(r.seconds_kernels * per, "%.1f") << " us, modes " << fixed(r.seconds_modes * per, "%.1f")
       << " us, response " << fixed(r.seconds_response * per, "%.1f") << " us\n";
   if (ns) out << "\n" << cell("quantity", 20) << cell("mean", 14) << cell("sd", 14) << cell("p5", 14) << cell("p50", 14) << "p95\n";
+  std::vector<std::string> undefined;
   for (std::size_t j = 0; j < ns; ++j) {
     std::vector<double> v;
     double sum = 0, sum2 = 0;
@@ -172,6 +176,12 @@ void write_summary(std::ostream& out, const Study& s, const std::vector<SobolRes
     out << cell(r.scalar_names[j], 20) << cell(fixed(mean, "%.6g"), 14) << cell(fixed(sd, "%.6g"), 14)
         << cell(fixed(percentile(v, 5), "%.6g"), 14) << cell(fixed(percentile(v, 50), "%.6g"), 14)
         << fixed(percentile(v, 95), "%.6g") << "\n";
+    if (v.size() < 2) undefined.push_back(r.scalar_names[j] + " (" + std::to_string(v.size()) + " finite value" + (v.size() == 1 ? ")" : "s)"));
+  }
+  if (!undefined.empty()) {
+    out << "# '-': a statistic with too few finite values: ";
+    for (std::size_t i = 0; i < undefined.size(); ++i) out << (i ? ", " : "") << undefined[i];
+    out << " (failed evaluations, listed on standard error, give no value)\n";
   }
   if (sobol.empty()) return;
   out << "\nSobol' indices (" << s.o.bootstrap << " bootstrap resamples, 95 % intervals):\n"
@@ -179,9 +189,10 @@ void write_summary(std::ostream& out, const Study& s, const std::vector<SobolRes
   for (std::size_t q = 0; q < sobol.size(); ++q)
     for (std::size_t j = 0; j < sobol[q].indices.size(); ++j) {
       const SobolIndex& x = sobol[q].indices[j];
-      char first[64], total[64];
-      std::snprintf(first, sizeof first, "%.4f [%.4f, %.4f]", x.first, x.first_low, x.first_high);
-      std::snprintf(total, sizeof total, "%.4f [%.4f, %.4f]", x.total, x.total_low, x.total_high);
+      const std::string first = fixed(x.first, "%.4f") + " [" + fixed(x.first_low, "%.4f") + ", " +
+                                fixed(x.first_high, "%.4f") + "]";
+      const std::string total = fixed(x.total, "%.4f") + " [" + fixed(x.total_low, "%.4f") + ", " +
+                                fixed(x.total_high, "%.4f") + "]";
       out << cell(r.scalar_names[q], 20) << cell(s.design.distributions()[j].name, 20) << cell(first, 28) << total << "\n";
     }
 }
@@ -247,7 +258,8 @@ CLI::App* add_study(CLI::App& app, StudyOptions& o) {
   s->add_option("--method", o.method, "frequency-response method");
   s->add_option("--threads", o.threads, "threads per process (default: the cores, shared by the processes)")
       ->check(CLI::Range(0, 4096));
-  s->add_option("--bootstrap", o.bootstrap, "bootstrap resamples of the Sobol' intervals")->check(CLI::Range(0L, 100000L));
+  s->add_option("--bootstrap", o.bootstrap, "bootstrap resamples of the Sobol' intervals, 10 to 100000")
+      ->check(CLI::Range(10L, 100000L));  // fewer give no 2.5 % and 97.5 % percentiles (0 printed [nan, nan])
   s->add_option("--write-samples", o.samples_file, "write every evaluation (parameters, quantities, status) as CSV");
   s->add_option("--bands", o.bands_file, "write the 5/25/50/75/95 % bands of the response (FILE.csv or FILE.json)");
   s->add_option("--sobol", o.sobol_file, "write the Sobol' indices (FILE.csv or FILE.json; saltelli design)");

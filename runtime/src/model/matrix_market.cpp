@@ -1,5 +1,7 @@
 #include "mbsgen/runtime/model/matrix_market.hpp"
 
+#include "model/text_file.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -266,10 +268,9 @@ void read_coordinate(Lines& lines, const Header& h, Eigen::MatrixXd& A) {
 }  // namespace
 
 Eigen::MatrixXd read_matrix_market(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw ParseError(path + ": is a directory, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ParseError(path + ": cannot open file");
+  // Regular files only (a FIFO or /dev/zero must not block or exhaust memory), up to 1 GiB: a
+  // dense array of 5000×5000 entries in full precision is about 0.6 GiB.
+  std::istringstream in(detail::read_regular_file<ParseError>(path, std::size_t{1} << 30));
   return read_matrix_market(in, path);
 }
 

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "mbsgen/runtime/time/simulation.hpp"
+#include "model/text_file.hpp"
 
 namespace mbsgen {
 
@@ -36,10 +37,18 @@ bool header_line(const std::string& line) {
   return !(std::isdigit(static_cast<unsigned char>(c)) || c == '+' || c == '-' || c == '.');
 }
 
+// Shortest text that reads back as x.
+std::string number_text(double x) {
+  std::ostringstream o;
+  o.precision(17);
+  o << x;
+  return o.str();
+}
+
 // Reads a CSV table of t,value lines (a first line that is not numbers is a header).
 InputSignal table_from_file(const std::string& path, const std::string& spec) {
-  std::ifstream in(path);
-  if (!in) throw NameError("input signal '" + spec + "': cannot read '" + path + "'");
+  // A regular file of at most 256 MiB (a FIFO or a device is refused at once, never read).
+  std::istringstream in(detail::read_regular_file<NameError>(path, std::size_t{1} << 28));
   std::vector<double> t, v;
   std::string line;
   for (long number = 1; std::getline(in, line); ++number) {
@@ -56,12 +65,13 @@ InputSignal table_from_file(const std::string& path, const std::string& spec) {
     } catch (const NameError&) {
       throw NameError(where + ": expected 't,value' with finite numbers, got '" + line + "'");
     }
+    // Checked here, with the file's line number (InputSignal::table only knows point indices).
+    if (t.size() >= 2 && !(t.back() > t[t.size() - 2]))
+      throw NameError(where + ": the times must increase strictly (" + line.substr(0, comma) +
+                      " follows " + number_text(t[t.size() - 2]) + ")");
   }
-  try {
-    return InputSignal::table(std::move(t), std::move(v));
-  } catch (const Error& e) {
-    throw NameError(path + ": " + e.what());
-  }
+  if (t.empty()) throw NameError(path + ": no 't,value' lines (a table needs at least one point)");
+  return InputSignal::table(std::move(t), std::move(v));
 }
 
 }  // namespace

@@ -119,7 +119,7 @@ TEST(MatrixMarket, ErrorsCarryFileAndLine) {
     mbsgen::read_matrix_market(dir);
     ADD_FAILURE() << "a directory was read as a matrix";
   } catch (const mbsgen::ParseError& e) {
-    EXPECT_EQ(std::string(e.what()), dir + ": is a directory, not a file");
+    EXPECT_EQ(std::string(e.what()), dir + ": is a directory, not a regular file");
   }
 }
 

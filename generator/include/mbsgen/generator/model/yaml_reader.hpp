@@ -20,6 +20,10 @@ namespace mbsgen {
 /// Model::add_* and Model::validate() reject); an unreadable file is a ModelError at `path`.
 Model read_model_file(const std::string& path);
 
+/// The text of the model file `path`, read without ever blocking: a FIFO, a device, a socket or
+/// a directory is a ModelError at `path` before a byte is read, as is a file above 64 MiB.
+std::string read_model_text(const std::string& path);
+
 /// Reads and validates a model from YAML `text`; `file_name` is used in error locations only.
 Model read_model_string(const std::string& text, const std::string& file_name);
 
