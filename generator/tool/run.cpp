@@ -386,7 +386,10 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
     write_files({{work / "main.cpp",
                   "#include \"model_model.hpp\"\n#include \"mbsgen/runtime/cli/solver_cli.hpp\"\n"
                   "int main(int argc, char** argv) { return mbsgen::cli::solver_main(model::kernels(), argc, argv); }\n"},
-                 {work / "model.yaml", text}});  // the model this solver was made from, for reference
+                 {work / "model.yaml", text},  // the model this solver was made from, for reference
+                 // The model's id: the solver's name is `<id>-solve` whatever the file is called,
+                 // as the generated code's (issue 39 §3). An identifier (Model's rule).
+                 {work / "id", full.name()}});
     if (!compile_solver(tc, work, code, parallel, progress)) return false;
     write_files({{work / "solve.sum", solver_record(work / "solve")}});  // last: the entry is complete
   } catch (...) {
@@ -461,7 +464,14 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   }
   const fs::path solver = dir / "solve";
   std::vector<char*> argv;
-  std::string name = fs::path(model_file).stem().string() + "-solve";
+  // `<id>-solve`, the model's id from the entry (an entry written before ids were recorded: the
+  // file's stem).
+  std::string id = fs::path(model_file).stem().string();
+  if (std::error_code ec; fs::is_regular_file(dir / "id", ec)) {
+    const std::string recorded = read_file(dir / "id");
+    if (!recorded.empty() && recorded.size() < 256) id = recorded;
+  }
+  std::string name = id + "-solve";
   argv.push_back(name.data());
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

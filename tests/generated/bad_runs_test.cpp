@@ -5,6 +5,7 @@
 //   fifo: NAME            (optional) a FIFO @TMP@/NAME, with no writer
 //   file: NAME            (optional) a file @TMP@/NAME whose lines follow, indented by two spaces
 //   $ COMMAND ARGS...     the first word a shipped solver `<id>-solve`, `mbsgen` or `mbsgen-linear`
+//   timeout: S           (optional) seconds instead of 30, for a case that compiles a solver
 //   exit N
 //   stderr: TEXT          a substring of the standard error
 // @DATA@ is tests/data, @MODELS@ models/, @TMP@ a fresh directory of the case.
@@ -40,6 +41,7 @@ struct Case {
   std::vector<std::pair<std::string, std::string>> files;
   int exit_code = -1;
   std::string stderr_text;
+  int timeout_s = 30;
 };
 
 std::string replace_all(std::string s, const std::string& from, const std::string& to) {
@@ -81,6 +83,8 @@ std::vector<Case> read_cases(const fs::path& path) {
       c.exit_code = std::stoi(line.substr(5));
     } else if (line.rfind("stderr: ", 0) == 0) {
       c.stderr_text = line.substr(8);
+    } else if (line.rfind("timeout: ", 0) == 0) {  // a case that compiles a solver
+      c.timeout_s = std::stoi(line.substr(9));
     } else if (line.rfind("fifo: ", 0) == 0) {
       c.fifos.push_back(line.substr(6));
     } else if (line.rfind("file: ", 0) == 0) {
@@ -106,7 +110,7 @@ struct Result {
   std::string err;
 };
 
-Result run(std::vector<std::string> argv, const fs::path& dir) {
+Result run(std::vector<std::string> argv, const fs::path& dir, int timeout_s) {
   const fs::path err_file = dir / ".stderr";
   argv[0] = program(argv[0]);
   std::vector<char*> args;
@@ -130,7 +134,7 @@ Result run(std::vector<std::string> argv, const fs::path& dir) {
     r.err = "cannot start " + argv[0];
     return r;
   }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(timeout_s);
   int status = 0;
   for (;;) {
     const pid_t w = ::waitpid(pid, &status, WNOHANG);
@@ -175,8 +179,8 @@ TEST(BadRuns, EveryCaseIsRefusedWithItsMessage) {
         a = replace_all(a, "@MODELS@", (fs::path(MBSGEN_SOURCE_DIR) / "models").string());
         a = replace_all(a, "@TMP@", tmp.string());
       }
-      const Result r = run(c.argv, tmp);
-      EXPECT_FALSE(r.timed_out) << where << ": did not return within 30 s";
+      const Result r = run(c.argv, tmp, c.timeout_s);
+      EXPECT_FALSE(r.timed_out) << where << ": did not return within " << c.timeout_s << " s";
       EXPECT_EQ(r.status, c.exit_code) << where << "\n" << r.err;
       EXPECT_NE(r.err.find(c.stderr_text), std::string::npos)
           << where << ": expected on stderr: " << c.stderr_text << "\ngot: " << r.err;
