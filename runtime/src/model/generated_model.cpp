@@ -173,6 +173,22 @@ Eigen::VectorXd GeneratedModel::outputs(const OperatingPoint& op) const {
   return z;
 }
 
+void check_mass_semidefinite(const Eigen::MatrixXd& M, const std::string& what) {
+  const Eigen::Index f = M.rows();
+  if (f == 0) return;
+  // The symmetric part: a mass matrix is symmetric up to the rounding of its kernel.
+  const Eigen::MatrixXd S = (M + M.transpose()) / 2;
+  const Eigen::VectorXd lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S, Eigen::EigenvaluesOnly).eigenvalues();
+  const double norm = lambda.cwiseAbs().maxCoeff();
+  // Rounding moves eigenvalues of a symmetric matrix by O(n·u·‖M‖); a margin of 1e-12·n·‖M‖.
+  if (lambda(0) < -1e-12 * static_cast<double>(f) * norm) {
+    char range[80];
+    std::snprintf(range, sizeof range, "%.3g to %.3g", lambda(0), lambda(f - 1));
+    throw Error(what + " is not positive semi-definite with these parameter values (eigenvalues " + range +
+                "): a negative mass or inertia?");
+  }
+}
+
 DescriptorModel GeneratedModel::descriptor_model(const OperatingPoint& op) const {
   if (!k_.descriptor)
     throw Error("GeneratedModel::descriptor_model: model '" + std::string(k_.model) +
@@ -186,6 +202,10 @@ DescriptorModel GeneratedModel::descriptor_model(const OperatingPoint& op) const
   auto data = [&](Eigen::MatrixXd& X) { return X.size() ? X.data() : dummy; };
   check_status(k_.descriptor(op.y0.data(), op.yd0.data(), p_.data(), E.data(), A.data(), data(B), data(C)),
                "descriptor", k_.model);
+  // The speeds' rows of E are the mass matrix in the independent speeds (Tᵀ M T): semi-definite
+  // for any physical parameters, so a negative mass shows here as it does in linear_model.
+  check_mass_semidefinite(E.bottomRightCorner(s, s), "GeneratedModel::descriptor_model: the mass matrix (in the independent "
+                                                      "speeds) of model '" + std::string(k_.model) + "'");
   std::vector<std::string> states = name_list(k_.coordinate_names, k_.n_coordinates);
   for (const auto& speed : name_list(k_.speed_names, k_.n_speeds)) states.push_back(speed + "_dot");
   return DescriptorModel(E, A, B, C, {}, states, name_list(k_.input_names, k_.n_inputs),
@@ -242,19 +262,7 @@ LinearModel GeneratedModel::linear_model(const OperatingPoint& op) const {
   check_status(k_.linear(op.y0.data(), op.yd0.data(), p_.data(), ptr(M), ptr(Q), ptr(K), ptr(B),
                          ptr(Cy), ptr(Cv)),
                "linear", k_.model);
-  if (f > 0) {
-    const Eigen::VectorXd lambda =
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(M, Eigen::EigenvaluesOnly).eigenvalues();
-    const double norm = lambda.cwiseAbs().maxCoeff();
-    // Rounding moves eigenvalues of a symmetric matrix by O(n·u·‖M‖); a margin of 1e-12·n·‖M‖.
-    if (lambda(0) < -1e-12 * static_cast<double>(f) * norm) {
-      char range[80];
-      std::snprintf(range, sizeof range, "%.3g to %.3g", lambda(0), lambda(f - 1));
-      throw Error("GeneratedModel::linear_model: the mass matrix of model '" + std::string(k_.model) +
-                  "' is not positive semi-definite with these parameter values (eigenvalues " +
-                  range + "): a negative mass or inertia?");
-    }
-  }
+  check_mass_semidefinite(M, "GeneratedModel::linear_model: the mass matrix of model '" + std::string(k_.model) + "'");
   LinearModel lin(std::move(M), std::move(Q), std::move(K), std::move(B), std::move(Cy),
                   std::move(Cv), name_list(k_.coordinate_names, k_.n_coordinates),
                   name_list(k_.input_names, k_.n_inputs), name_list(k_.output_names, k_.n_outputs),

@@ -836,6 +836,13 @@ SimulationResult simulate(const GeneratedModel& model, const OperatingPoint& op,
   x0 << y, yd;
   if (!eq.evaluate(0.0, y.data(), yd.data()))
     throw SimulationError("simulate: the initial state fails " + at_time(0) + ": " + eq.reason(), 0.0);
+  // A negative mass or inertia given at run time: refused as linear_model refuses it (it
+  // integrated before, issue 39 §1). M at the initial configuration, in the model's coordinates.
+  if (k.mass_matrix && !eq.follows_loops()) {
+    Eigen::MatrixXd M(n, n);
+    if (n > 0 && k.mass_matrix(y.data(), model.parameters().data(), M.data()) == 0)
+      check_mass_semidefinite(M, "simulate: the mass matrix of model '" + std::string(k.model) + "' at the initial state");
+  }
   std::unique_ptr<Integrator> in;
   if (o.method == IntegrationMethod::radau || o.method == IntegrationMethod::radau9)
     in = std::make_unique<RadauIntegrator>(eq, o, x0);

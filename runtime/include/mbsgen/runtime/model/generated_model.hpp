@@ -155,6 +155,12 @@ struct OperatingPoint {
   std::string report;        ///< one line: how the point was obtained
 };
 
+/// Throws Error "<what> is not positive semi-definite with these parameter values (eigenvalues
+/// …): a negative mass or inertia?" when the symmetric part of M has an eigenvalue below
+/// −1e-12·n·‖M‖ (rounding). What linear_model, descriptor_model and simulate check, so that a
+/// negative mass given at run time (--set, a sweep, a study sample) is refused everywhere.
+void check_mass_semidefinite(const Eigen::MatrixXd& M, const std::string& what);
+
 class GeneratedModel {
  public:
   /// Throws mbsgen::Error when the kernels' ABI version differs from kKernelAbiVersion.
