@@ -114,7 +114,7 @@ int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& sce
 // mbsgen run MODEL [--scene NAME] [-- ARGS...]
 int run_command(int argc, char** argv) {
   const char* usage =
-      "usage: mbsgen run MODEL [--scene NAME] -- info|modes|frf|static|sweep|matrices|simulate|study [ARGS...]\n"
+      "usage: mbsgen run MODEL [--scene NAME] -- info|modes|frf|static|sweep|matrices|simulate|study|outputs [ARGS...]\n"
       "  generates, compiles and caches the model's solver, then runs it with ARGS\n"
       "  (the solver's options: mbsgen run MODEL -- --help)\n";
   std::string model_file, scene = "full";

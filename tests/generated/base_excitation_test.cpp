@@ -282,4 +282,24 @@ TEST(BaseExcitation, MiddleEarBoneConductionIsInertial) {
   EXPECT_NEAR(std::abs(z[1] / z[0]), 4.0, 4e-3) << "Omega^2 at 1 and 2 Hz";
 }
 
+// Outputs at any state (issue 39 §4): the force of the mount on the mass, −k x − c ẋ, with the
+// table at rest (x absolute); a force input does not move the mount; a nonzero motion input is
+// refused, not ignored (the outputs hold the support at its reference position).
+TEST(OutputsAt, MountForceIsTheSpringAndDamperForce) {
+  mbsgen::GeneratedModel model(base_excited_oscillator::kernels());
+  const double k = 800, c = 8, x = 0.01, v = 0.2;
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(2);
+  u[1] = 3.0;  // F
+  const Eigen::VectorXd z = model.outputs_at(Eigen::VectorXd::Constant(1, x), Eigen::VectorXd::Constant(1, v),
+                                             Eigen::VectorXd::Constant(1, 0.5), u);
+  ASSERT_EQ(z.size(), 6);
+  EXPECT_EQ(z[0], x);
+  EXPECT_EQ(z[1], v);
+  EXPECT_NEAR(z[5], -k * x - c * v, 4e-16 * (k * x + c * v));
+  u[0] = 0.004;  // xb
+  EXPECT_THROW(model.outputs_at(Eigen::VectorXd::Constant(1, x), Eigen::VectorXd::Constant(1, v),
+                                Eigen::VectorXd::Zero(1), u),
+               mbsgen::Error);
+}
+
 }  // namespace

@@ -813,4 +813,35 @@ TEST(Simulation, SceneKeepsWhatMotionNeeds) {
   EXPECT_LT(worst_full, 1e-7 * A);
 }
 
+// Outputs at any state (issue 39 §4; before, only a one-step simulation gave them). The simple
+// pendulum's bob at x = l sin φ for any φ and rates; a four-bar's joint loads at its operating
+// point with no acceleration and no input equal those `static` prints (the same loads by another
+// kernel).
+TEST(OutputsAt, AnyStateMatchesClosedFormsAndTheStaticLoads) {
+  GeneratedModel pendulum(simple_pendulum::kernels());
+  pendulum.set("l", 0.7);
+  for (double phi : {-2.0, 0.0, 0.5, 3.0}) {
+    const Eigen::VectorXd y = Eigen::VectorXd::Constant(1, phi), yd = Eigen::VectorXd::Constant(1, 4.0);
+    const Eigen::VectorXd z = pendulum.outputs_at(y, yd, Eigen::VectorXd::Constant(1, -1.0), Eigen::VectorXd());
+    ASSERT_EQ(z.size(), 2);
+    EXPECT_EQ(z[0], phi);                                     // angle: the coordinate itself
+    EXPECT_NEAR(z[1], 0.7 * std::sin(phi), 2e-16 * 0.7);      // bob_x, one rounding of sin and a product
+  }
+  EXPECT_THROW(pendulum.outputs_at(Eigen::VectorXd::Zero(2), Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(1),
+                                   Eigen::VectorXd()),
+               mbsgen::DimensionError);
+  EXPECT_THROW(pendulum.outputs_at(Eigen::VectorXd::Constant(1, NAN), Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(1),
+                                   Eigen::VectorXd()),
+               mbsgen::NonFiniteError);
+
+  GeneratedModel bar(four_bar::kernels());
+  const mbsgen::OperatingPoint op = bar.operating_point();
+  const Eigen::Index f = bar.size();
+  const Eigen::VectorXd at_rest = bar.outputs_at(op.y0, op.yd0, Eigen::VectorXd::Zero(f), Eigen::VectorXd::Zero(bar.kernels().n_inputs));
+  const Eigen::VectorXd loads = bar.outputs(op);
+  ASSERT_EQ(at_rest.size(), loads.size());
+  for (Eigen::Index i = 0; i < loads.size(); ++i)
+    EXPECT_NEAR(at_rest[i], loads[i], 1e-13 * (1 + std::abs(loads[i]))) << i;  // two kernels' rounding
+}
+
 }  // namespace

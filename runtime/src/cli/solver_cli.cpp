@@ -18,6 +18,7 @@
 #include "cli/bode_plot.hpp"
 #include "cli/cli_files.hpp"
 #include "cli/cli_output.hpp"
+#include "cli/outputs_cli.hpp"
 #include "cli/sensitivity_cli.hpp"
 #include "cli/simulate_cli.hpp"
 #include "cli/study_cli.hpp"
@@ -484,6 +485,8 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   CLI::App* simulate = add_simulate(app, simulate_options);
   StudyOptions study_options;
   CLI::App* study = add_study(app, study_options);
+  OutputsOptions outputs_options;
+  CLI::App* outputs = add_outputs(app, outputs_options);
   o.format = "table";
   try {
     app.parse(argc, argv);
@@ -518,6 +521,7 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     if (sweep->parsed()) return run_sweep(k, o, out, err);
     if (simulate->parsed()) return run_simulate(k, simulate_options, out, err);
     if (study->parsed()) return run_study(k, study_options, out, err);
+    if (outputs->parsed()) return run_outputs(k, outputs_options, out);
     return run_matrices(k, o, out, err);
   } catch (const NameError& e) {
     err << program << ": " << e.what() << "\n";

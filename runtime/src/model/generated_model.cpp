@@ -189,6 +189,44 @@ void check_mass_semidefinite(const Eigen::MatrixXd& M, const std::string& what) 
   }
 }
 
+Eigen::VectorXd GeneratedModel::outputs_at(const Eigen::VectorXd& y, const Eigen::VectorXd& yd,
+                                           const Eigen::VectorXd& ydd, const Eigen::VectorXd& u) const {
+  const char* who = "GeneratedModel::outputs_at";
+  if (k_.descriptor)
+    throw Error(std::string(who) + ": model '" + k_.model + "' has nonholonomic constraints: its coordinate rates "
+                "are not free, and a state that violates the velocity constraints would give outputs that mean "
+                "nothing (the outputs at the operating point: outputs(operating_point()))");
+  const Eigen::Index f = size(), m = k_.n_inputs;
+  if (y.size() != f || yd.size() != f || ydd.size() != f || u.size() != m)
+    throw DimensionError(std::string(who) + ": y, yd, ydd, u of sizes " + std::to_string(y.size()) + "/" +
+                         std::to_string(yd.size()) + "/" + std::to_string(ydd.size()) + "/" + std::to_string(u.size()) +
+                         " for a model with " + std::to_string(f) + " coordinates and " + std::to_string(m) + " inputs");
+  if (!y.allFinite() || !yd.allFinite() || !ydd.allFinite() || !u.allFinite())
+    throw NonFiniteError(std::string(who) + ": the state has a non-finite entry");
+  if (!k_.outputs || k_.n_outputs == 0) return {};
+  Eigen::VectorXd z(k_.n_outputs);
+  if (k_.outputs_general) {
+    double no_input[1] = {0.0};  // kernels read no u of a model without inputs; a valid pointer anyway
+    check_status(k_.outputs_general(y.data(), yd.data(), ydd.data(), u.size() ? u.data() : no_input, p_.data(), z.data()),
+                 "outputs_general", k_.model);
+  } else if (k_.output_terms && !k_.input_kinds) {
+    // Kernels from before outputs_general: their `outputs` give static loads whatever ÿ and u.
+    throw Error(std::string(who) + ": the kernels of model '" + k_.model + "' give its loads only at rest (generated "
+                "before outputs at any state existed): regenerate them");
+  } else {
+    // No output depends on ÿ, nor on a force input; a model with motion inputs has its
+    // outputs with the support at rest at its reference position (as a simulation holds it), so
+    // a nonzero motion input is refused rather than ignored.
+    for (Eigen::Index i = 0; i < m; ++i)
+      if (u[i] != 0.0 && k_.input_kinds && std::string(k_.input_kinds[i]) == "motion")
+        throw Error(std::string(who) + ": input '" + k_.input_names[i] + "' of model '" + k_.model +
+                    "' prescribes motion: its outputs are computed with the support at its reference position; "
+                    "give the state relative to it (a nonzero motion input is not supported here)");
+    check_status(k_.outputs(y.data(), yd.data(), p_.data(), z.data()), "outputs", k_.model);
+  }
+  return z;
+}
+
 DescriptorModel GeneratedModel::descriptor_model(const OperatingPoint& op) const {
   if (!k_.descriptor)
     throw Error("GeneratedModel::descriptor_model: model '" + std::string(k_.model) +

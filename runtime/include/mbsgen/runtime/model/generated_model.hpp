@@ -229,6 +229,16 @@ class GeneratedModel {
   /// The outputs z at the operating point (for outputs that depend on ÿ and u: at ÿ = 0 and
   /// u = 0, the static loads); empty when the kernels do not provide `outputs`.
   Eigen::VectorXd outputs(const OperatingPoint& op) const;
+  /// The outputs z (joint loads included) at any state: coordinates y, rates ẏ, accelerations ÿ
+  /// and inputs u (issue 39 §4; before, only a one-step simulation gave them). ÿ and u enter
+  /// the outputs that depend on them (reactions, accelerations); the others read y and ẏ only.
+  /// For a model with closed loops y are the independent coordinates, the loops closed by the
+  /// kernels. Throws Error for a model with nonholonomic constraints (its coordinate rates are
+  /// not free: a state that violates the velocity constraints would give numbers that mean
+  /// nothing, and the kernels cannot check it), DimensionError for vectors of the wrong size,
+  /// NonFiniteError for non-finite entries.
+  Eigen::VectorXd outputs_at(const Eigen::VectorXd& y, const Eigen::VectorXd& yd, const Eigen::VectorXd& ydd,
+                             const Eigen::VectorXd& u) const;
 
  private:
   Eigen::VectorXd residual(const Eigen::VectorXd& y, const Eigen::VectorXd& yd) const;
