@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 
 #include "mbsgen/runtime/model/static_equilibrium.hpp"
 
@@ -246,6 +247,35 @@ DescriptorModel GeneratedModel::descriptor_model(const OperatingPoint& op) const
                                                       "speeds) of model '" + std::string(k_.model) + "'");
   std::vector<std::string> states = name_list(k_.coordinate_names, k_.n_coordinates);
   for (const auto& speed : name_list(k_.speed_names, k_.n_speeds)) states.push_back(speed + "_dot");
+  // An equation that vanishes in both E and A makes det(λE − A) ≡ 0. The model file's values
+  // never do that (the generator checks them), so run-time parameter values did: name the ones
+  // whose model-file value alone restores the equation (a wheel radius r = 0), not only the
+  // equation.
+  for (Eigen::Index i = 0; i < n; ++i)
+    if ((E.row(i).array() == 0.0).all() && (A.row(i).array() == 0.0).all()) {
+      // A parameter is named when its model-file value alone makes the equation come back.
+      std::string suspects;
+      const auto names = name_list(k_.parameter_names, k_.n_parameters);
+      for (std::size_t j = 0; j < names.size(); ++j) {
+        if (p_[j] == k_.parameter_defaults[j]) continue;
+        std::vector<double> q = p_;
+        q[j] = k_.parameter_defaults[j];
+        Eigen::MatrixXd E2(n, n), A2(n, n), B2(n, m), C2(r, n);
+        if (k_.descriptor(op.y0.data(), op.yd0.data(), q.data(), E2.data(), A2.data(), data(B2), data(C2)) != 0) continue;
+        if (!(E2.row(i).array() == 0.0).all() || !(A2.row(i).array() == 0.0).all()) {
+          std::ostringstream v;
+          v.precision(17);
+          v << names[j] << " = " << p_[j];
+          suspects += (suspects.empty() ? "" : ", ") + v.str();
+        }
+      }
+      throw SingularSystemError("GeneratedModel::descriptor_model: with these parameter values the equation of state '" +
+                                states[static_cast<std::size_t>(i)] + "' of model '" + k_.model +
+                                "' vanishes in both E and A, so det(λE − A) ≡ 0" +
+                                (suspects.empty() ? std::string()
+                                                  : "; the parameter value that does it: " + suspects +
+                                                        " (its model-file value does not)"));
+    }
   return DescriptorModel(E, A, B, C, {}, states, name_list(k_.input_names, k_.n_inputs),
                          name_list(k_.output_names, k_.n_outputs), name_list(k_.input_units, k_.n_inputs),
                          name_list(k_.output_units, k_.n_outputs));
