@@ -8,7 +8,7 @@
 //   timeout: S           (optional) seconds instead of 30, for a case that compiles a solver
 //   exit N
 //   stderr: TEXT          a substring of the standard error
-// @DATA@ is tests/data, @MODELS@ models/, @TMP@ a fresh directory of the case.
+// @DATA@ is tests/data, @MODELS@ models/, @TMP@ a fresh directory of the case (also in stderr:).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -179,6 +179,7 @@ TEST(BadRuns, EveryCaseIsRefusedWithItsMessage) {
         a = replace_all(a, "@MODELS@", (fs::path(MBSGEN_SOURCE_DIR) / "models").string());
         a = replace_all(a, "@TMP@", tmp.string());
       }
+      c.stderr_text = replace_all(c.stderr_text, "@TMP@", tmp.string());  // a message may name the path
       const Result r = run(c.argv, tmp, c.timeout_s);
       EXPECT_FALSE(r.timed_out) << where << ": did not return within " << c.timeout_s << " s";
       EXPECT_EQ(r.status, c.exit_code) << where << "\n" << r.err;

@@ -121,7 +121,10 @@ TEST(SolverCli, ExitCodes) {
   EXPECT_NE(err.find("unknown parameter 'nope'"), std::string::npos) << err;
   EXPECT_NE(err.find("known: m1, m2, l1, l2, g"), std::string::npos) << err;
   EXPECT_EQ(solve({"modes", "--set", "g=abc"}), 2);                // malformed number
-  EXPECT_EQ(solve({"modes", "--set", "g=nan"}), 1);                // non-finite: a model error
+  EXPECT_EQ(solve({"modes", "--set", "g=nan"}, nullptr, &err), 2);  // non-finite: a usage error
+  EXPECT_NE(err.find("--set 'g=nan': 'nan' is not a finite number"), std::string::npos) << err;
+  EXPECT_EQ(solve({"modes", "--set", "g=1e999"}, nullptr, &err), 2);  // beyond double
+  EXPECT_NE(err.find("outside the range of double"), std::string::npos) << err;
   EXPECT_EQ(solve({"frf", "--input", "X", "--output", "x2"}, nullptr, &err), 2);
   EXPECT_NE(err.find("unknown input 'X'"), std::string::npos) << err;
   EXPECT_EQ(solve({"frf", "--input", "F", "--output", "x2", "--from", "10", "--to", "1"}), 2);

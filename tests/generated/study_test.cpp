@@ -194,13 +194,13 @@ TEST(Study, SolverCommandLine) {
                  dir + "/s.csv"}, out, err), 0) << err;
   EXPECT_EQ(run({"study", "--parameter", "kk=lognormal:800:1.5", "--samples", "8", "--modes", "1"}, out, err), 2);
   EXPECT_NE(err.find("no parameter 'kk'"), std::string::npos) << err;
-  EXPECT_EQ(run({"study", "--parameter", "k=lognormal:800:0.5", "--samples", "8", "--modes", "1"}, out, err), 1);
+  EXPECT_EQ(run({"study", "--parameter", "k=lognormal:800:0.5", "--samples", "8", "--modes", "1"}, out, err), 2);
   EXPECT_NE(err.find("k=lognormal:800:0.5"), std::string::npos) << err;
   EXPECT_EQ(run({"study", "--parameter", "k=uniform:1:2", "--samples", "8", "--design", "saltelli", "--input", "F",
-                 "--output", "x_abs", "--from", "1", "--to", "2"}, out, err), 1);
+                 "--output", "x_abs", "--from", "1", "--to", "2"}, out, err), 2);
   EXPECT_NE(err.find("need scalar quantities"), std::string::npos) << err;
   EXPECT_EQ(run({"study", "--parameter", "k=uniform:1:2", "--samples", "8", "--modes", "1", "--sobol", dir + "/x.csv"},
-                out, err), 1);
+                out, err), 2);
   EXPECT_NE(err.find("--sobol needs the saltelli design"), std::string::npos) << err;
   // A file mbsgen did not write is refused before the evaluations, and left as it was.
   {

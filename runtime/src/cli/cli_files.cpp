@@ -92,6 +92,17 @@ void refuse_special_file(const fs::path& path, const std::string& what) {
   (void)exists_regular(path, what);
 }
 
+void refuse_non_directory(const fs::path& path, const std::string& what) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) return;
+    throw system_error(what + ": cannot inspect", path, errno);
+  }
+  if (!S_ISDIR(st.st_mode))
+    throw Error(what + ": " + path.string() + ": it is " + (S_ISREG(st.st_mode) ? "a regular file" : kind_of(st.st_mode)) +
+                ", not a directory");
+}
+
 void refuse_foreign_files(const std::vector<fs::path>& paths, const std::string& marker, const std::string& what) {
   for (const auto& p : paths)
     if (exists_regular(p, what) && head_of(p, 400, what).find(marker) == std::string::npos)

@@ -18,6 +18,9 @@ struct OutputFile {
   std::string content;
 };
 
+/// Throws Error when `path` exists and is not a directory (following links): an output directory
+/// that is a regular file, a FIFO or a device. `what` names the option (e.g. "matrices --out").
+void refuse_non_directory(const std::filesystem::path& path, const std::string& what);
 /// Throws Error, as write_all_or_nothing would, when one of paths exists and is not a regular file
 /// whose first 400 bytes contain `marker`: for a command that checks its targets before long work.
 void refuse_foreign_files(const std::vector<std::filesystem::path>& paths, const std::string& marker,

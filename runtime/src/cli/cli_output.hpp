@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <ostream>
@@ -22,19 +23,35 @@ namespace mbsgen::cli {
 std::string num(double v, bool json);
 /// %.6e, for tables ("-" for an undefined value, "inf"/"-inf").
 std::string short_num(double v);
-/// A command-line frequency in Hz: a finite number ≥ 0, with a readable message otherwise.
+/// The largest frequency the command lines take [Hz]: its angular frequency 2π f stays finite
+/// (1e308 Hz gave "frequency 186 is inf rad/s" from the library, exit 1).
+inline constexpr double kMaxFrequencyHz = 1e300;
+/// A command-line frequency in Hz: a finite number in [0, 1e300], with a readable message otherwise.
 inline CLI::Validator frequency_hz() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
         try {
           std::size_t used = 0;
           const double v = std::stod(text, &used);
-          if (used == text.size() && std::isfinite(v) && v >= 0) return "";
+          if (used == text.size() && std::isfinite(v) && v >= 0 && v <= kMaxFrequencyHz) return "";
         } catch (const std::exception&) {
         }
-        return "'" + text + "' is not a frequency in Hz (a finite number >= 0)";
+        return "'" + text + "' is not a frequency in Hz (a finite number in [0, 1e300])";
       },
       "HZ", "frequency_hz");
+}
+/// A seed: an unsigned 64-bit integer written in decimal digits (CLI11 took "-1" as 2^64 - 1 and
+/// 1e30 digits as the largest seed, silently).
+inline CLI::Validator seed_value() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        static const std::string max = "18446744073709551615";
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        std::string t = text.substr(std::min(text.find_first_not_of('0'), text.size()));
+        if (digits && (t.size() < max.size() || (t.size() == max.size() && t <= max))) return "";
+        return "'" + text + "' is not a seed (an integer in [0, 18446744073709551615])";
+      },
+      "SEED", "seed_value");
 }
 /// A command-line number that must be finite and within [lo, hi] (lo excluded when lo_open):
 /// `nan`, `inf`, 1e400 and out-of-range values are usage errors (exit 2) whose message states the

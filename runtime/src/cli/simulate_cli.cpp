@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "cli/bode_plot.hpp"
 #include "cli/cli_files.hpp"
@@ -21,6 +22,13 @@ std::pair<std::string, std::string> assignment(const std::string& text, const ch
   if (eq == std::string::npos || eq == 0)
     throw NameError(std::string(option) + " '" + text + "': expected NAME=VALUE");
   return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+// %.6g: a number in a message, short.
+std::string g6(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
 }
 
 SimulationOptions simulation_options(const GeneratedModel& model, const SimulateOptions& o) {
@@ -40,8 +48,18 @@ SimulationOptions simulation_options(const GeneratedModel& model, const Simulate
   }
   for (const std::string& a : o.atol_of) {
     const auto [name, text] = assignment(a, "--atol-of");
-    s.atol_of.emplace_back(name, finite_number(text, "--atol-of '" + a + "'"));
+    const double atol = finite_number(text, "--atol-of '" + a + "'");
+    if (!(atol > 0)) throw NameError("--atol-of '" + a + "': an absolute tolerance must be > 0");
+    s.atol_of.emplace_back(name, atol);
   }
+  // The samples kept in memory, as simulate() counts them (5e7 values), a usage error here: 1e300
+  // seconds sampled every 1e-300 s was a run failure that printed "inf samples".
+  const double per_sample = 2.0 * model.size() + model.kernels().n_inputs + model.kernels().n_outputs;
+  if (!(s.duration / s.step + 1 <= 5e7 / per_sample))
+    throw NameError("simulate: --duration " + g6(s.duration) + " sampled every " + g6(s.step) +
+                    " s gives more than " + std::to_string(static_cast<long>(5e7 / per_sample)) + " samples of " +
+                    std::to_string(static_cast<long>(per_sample)) +
+                    " values (400 MB): sample less often (--step) or simulate less time");
   if (!o.inputs.empty()) s.inputs.resize(static_cast<std::size_t>(model.kernels().n_inputs));
   for (const std::string& a : o.inputs) {
     const auto [name, spec] = assignment(a, "--input");

@@ -7,7 +7,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <new>
@@ -343,6 +345,7 @@ int run_matrices(const ModelKernels& k, const Options& o, std::ostream& out, std
   if (o.format == "mtx") {
     namespace fs = std::filesystem;
     const fs::path dir = o.out_dir.empty() ? fs::path(".") : fs::path(o.out_dir);
+    refuse_non_directory(dir, "matrices --out");  // "filesystem error: cannot create directories" was all it said
     fs::create_directories(dir);
     // mbsgen's files say so on their first comment line; only those are replaced (docs/cli.md).
     std::vector<OutputFile> files;
@@ -415,6 +418,25 @@ std::string sweep_from_scene(const ModelKernels& k, const CLI::App& frf, Options
   if (frf.get_option("--spacing")->count() == 0 && scene)
     o.spacing = k.default_linear_spacing ? "linear" : "log";
   return sweep_problem(o.from, o.to, o.points, o.spacing == "log");
+}
+
+// --set NAME=VALUE of every subcommand: a value beyond the range of double or not finite is a
+// usage error (exit 2), as a malformed one is (`--set g=nan` was exit 1). "" or the problem; a
+// malformed entry is left to GeneratedModel::set, which names it.
+std::string set_value_problem(const std::vector<std::string>& sets) {
+  for (const std::string& a : sets) {
+    const auto eq = a.find('=');
+    if (eq == std::string::npos) continue;
+    const std::string text = a.substr(eq + 1);
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0') continue;
+    if (errno == ERANGE)
+      return "--set '" + a + "': '" + text + "' is outside the range of double (magnitudes 2.2e-308 to 1.8e308, or 0)";
+    if (!std::isfinite(v)) return "--set '" + a + "': '" + text + "' is not a finite number";
+  }
+  return "";
 }
 
 }  // namespace
@@ -500,6 +522,13 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     }
     err << program << ": " << e.what() << "\nRun with --help for more information.\n";
     return 2;
+  }
+  for (const auto* sets : {&o.set, &simulate_options.set, &study_options.set, &outputs_options.set}) {
+    const std::string problem = set_value_problem(*sets);
+    if (!problem.empty()) {
+      err << program << ": " << problem << "\nRun with --help for more information.\n";
+      return 2;
+    }
   }
   if (matrices->parsed() && o.format == "table") o.format = "json";
   o.sensitivity_given = (modes->parsed() && modes->get_option("--sensitivity")->count() > 0) ||

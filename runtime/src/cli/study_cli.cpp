@@ -243,7 +243,8 @@ CLI::App* add_study(CLI::App& app, StudyOptions& o) {
   s->add_option("--samples", o.samples, "evaluations (Saltelli: base samples N, N·(d+2) evaluations)")
       ->required()
       ->check(CLI::Range(1L, 100000000L));
-  s->add_option("--seed", o.seed, "seed of the design (the same seed gives the same numbers on any number of processes)");
+  s->add_option("--seed", o.seed, "seed of the design (the same seed gives the same numbers on any number of processes)")
+      ->check(seed_value());
   s->add_option("--modes", o.modes, "record the lowest K modes' natural frequencies and damping ratios")
       ->check(CLI::Range(0, 100000));
   s->add_option("--input", o.input, "input of the response");
@@ -278,19 +279,19 @@ StudyQuantities quantities(const ModelKernels& k, const StudyOptions& o) {
   q.at_hz = o.at_hz;
   const bool response = !o.input.empty() || !o.output.empty();
   if (response && (o.input.empty() || o.output.empty()))
-    throw Error("study: a response needs both --input and --output");
-  if (!response && !o.at_hz.empty()) throw Error("study: --at needs --input and --output");
+    throw NameError("study: a response needs both --input and --output");
+  if (!response && !o.at_hz.empty()) throw NameError("study: --at needs --input and --output");
   if (response && o.points > 0) {
     double from = o.from, to = o.to;
     if (from == 0 && to == 0) from = k.default_from_hz, to = k.default_to_hz;
     if (from == 0 && to == 0)
-      throw Error("study: the band needs --from and --to (the scene gives no frequency range), or --points 0");
+      throw NameError("study: the band needs --from and --to (the scene gives no frequency range), or --points 0");
     const std::string problem = sweep_problem(from, to, o.points, o.spacing == "log");
-    if (!problem.empty()) throw Error("study: " + problem);
+    if (!problem.empty()) throw NameError("study: " + problem);
     const Eigen::VectorXd hz = sweep_hz(from, to, o.points, o.spacing == "log");
     q.sweep_hz.assign(hz.data(), hz.data() + hz.size());
   }
-  if (q.modes == 0 && !response) throw Error("study: nothing to record: ask for --modes K, or a response (--input, --output)");
+  if (q.modes == 0 && !response) throw NameError("study: nothing to record: ask for --modes K, or a response (--input, --output)");
   return q;
 }
 
@@ -298,25 +299,38 @@ StudyQuantities quantities(const ModelKernels& k, const StudyOptions& o) {
 
 namespace {
 
+// --parameter: the library's parse, its refusal a usage error (exit 2) naming the option instead
+// of the function ("parse_distribution: ..." was exit 1).
+ParameterDistribution distribution_option(const std::string& text) {
+  try {
+    return parse_distribution(text);
+  } catch (const Error& e) {
+    std::string what = e.what();
+    const std::string prefix = "parse_distribution: ";
+    if (what.rfind(prefix, 0) == 0) what.erase(0, prefix.size());
+    throw NameError("--parameter " + what);
+  }
+}
+
 // Everything before the evaluations: the model's parameters, the design, the quantities, and the
 // checks that can fail (on rank 0, the files it will write). Throws what a bad option gives.
 std::unique_ptr<Study> prepare(const ModelKernels& k, const StudyOptions& o, GeneratedModel& model,
                                const Cluster& cluster) {
   for (const auto& a : o.set) model.set(a);
   std::vector<ParameterDistribution> dists;
-  for (const auto& p : o.parameters) dists.push_back(parse_distribution(p));
+  for (const auto& p : o.parameters) dists.push_back(distribution_option(p));
   const Design design_kind = parse_design(o.design);
   auto s = std::make_unique<Study>(Study{k, o, StudyDesign(design_kind, dists, static_cast<std::size_t>(o.samples), o.seed),
                                          quantities(k, o), {}, 0, 1, ""});
   if (design_kind == Design::saltelli && scalar_names(s->q).empty())
-    throw Error("study: Sobol' indices (saltelli) need scalar quantities: --modes K or --at FREQUENCIES");
+    throw NameError("study: Sobol' indices (saltelli) need scalar quantities: --modes K or --at FREQUENCIES");
   if (design_kind != Design::saltelli && !o.sobol_file.empty())
-    throw Error("study: --sobol needs the saltelli design");
+    throw NameError("study: --sobol needs the saltelli design");
   if ((!o.bands_file.empty() || !o.plot.empty()) && s->q.sweep_hz.empty())
-    throw Error("study: --bands and --plot need a response band (--input, --output and --points > 0)");
+    throw NameError("study: --bands and --plot need a response band (--input, --output and --points > 0)");
   const std::string ext = std::filesystem::path(o.plot).extension().string();
   if (!o.plot.empty() && ext != ".svg" && ext != ".png")
-    throw Error("study: --plot " + o.plot + ": the file name must end in .svg or .png");
+    throw NameError("study: --plot " + o.plot + ": the file name must end in .svg or .png");
   // One gather (MPI_Gatherv) carries at most 2^31 − 1 values of each kind.
   const std::size_t per_evaluation = std::max(s->q.sweep_hz.size(), scalar_names(s->q).size());
   const std::size_t values = s->design.size() * per_evaluation;
