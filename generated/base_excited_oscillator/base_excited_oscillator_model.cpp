@@ -18,7 +18,7 @@ std::array<double, 3> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "base_excited_oscillator", "base_excited_oscillator", "full", base_excited_oscillator_abi_version(),
       1, 2, 6, 3, true, false, 0.0, 0.0,
       base_excited_oscillator_coordinate_names, coordinate_units, base_excited_oscillator_parameter_names, parameter_units, base_excited_oscillator_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       base_excited_oscillator_input_kinds, &base_excited_oscillator_excitation,
       base_excited_oscillator_n_sensitivity_parameters, base_excited_oscillator_sensitivity_parameter_names, &base_excited_oscillator_sensitivity, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = base_excited_oscillator_n_checks;
+    with_checks.check_kinds = base_excited_oscillator_check_kinds;
+    with_checks.check_labels = base_excited_oscillator_check_labels;
+    with_checks.check_units = base_excited_oscillator_check_units;
+    with_checks.check_parameters = base_excited_oscillator_check_parameters;
+    with_checks.physical = &base_excited_oscillator_physical;
+    return with_checks;
+  }();
   return k;
 }
 

@@ -18,7 +18,7 @@ std::array<double, 13> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "chain3_sympy", "chain3_sympy", "full", chain3_sympy_abi_version(),
       3, 1, 3, 13, true, false, 0.0, 0.0,
       chain3_sympy_coordinate_names, coordinate_units, chain3_sympy_parameter_names, parameter_units, chain3_sympy_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       chain3_sympy_n_sensitivity_parameters, chain3_sympy_sensitivity_parameter_names, &chain3_sympy_sensitivity, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = chain3_sympy_n_checks;
+    with_checks.check_kinds = chain3_sympy_check_kinds;
+    with_checks.check_labels = chain3_sympy_check_labels;
+    with_checks.check_units = chain3_sympy_check_units;
+    with_checks.check_parameters = chain3_sympy_check_parameters;
+    with_checks.physical = &chain3_sympy_physical;
+    return with_checks;
+  }();
   return k;
 }
 

@@ -18,7 +18,7 @@ std::array<double, 5> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "double_pendulum", "double_pendulum", "full", double_pendulum_abi_version(),
       2, 1, 4, 5, true, false, 0.0, 0.0,
       double_pendulum_coordinate_names, coordinate_units, double_pendulum_parameter_names, parameter_units, double_pendulum_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       double_pendulum_n_sensitivity_parameters, double_pendulum_sensitivity_parameter_names, &double_pendulum_sensitivity, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = double_pendulum_n_checks;
+    with_checks.check_kinds = double_pendulum_check_kinds;
+    with_checks.check_labels = double_pendulum_check_labels;
+    with_checks.check_units = double_pendulum_check_units;
+    with_checks.check_parameters = double_pendulum_check_parameters;
+    with_checks.physical = &double_pendulum_physical;
+    return with_checks;
+  }();
   return k;
 }
 

@@ -18,7 +18,7 @@ std::array<double, 8> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "four_bar", "four_bar", "full", four_bar_abi_version(),
       1, 1, 5, 8, true, true, 0.0, 0.0,
       four_bar_coordinate_names, coordinate_units, four_bar_parameter_names, parameter_units, four_bar_parameter_defaults,
@@ -29,6 +29,16 @@ const mbsgen::ModelKernels& kernels() {
       &four_bar_dynamics, nullptr, &four_bar_outputs_general,
       four_bar_n_tree_coordinates, four_bar_n_constraints, &four_bar_assemble, &four_bar_constraints,
       &four_bar_assemble_from, &four_bar_dynamics_full, &four_bar_outputs_full, &four_bar_outputs_general_full};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = four_bar_n_checks;
+    with_checks.check_kinds = four_bar_check_kinds;
+    with_checks.check_labels = four_bar_check_labels;
+    with_checks.check_units = four_bar_check_units;
+    with_checks.check_parameters = four_bar_check_parameters;
+    with_checks.physical = &four_bar_physical;
+    return with_checks;
+  }();
   return k;
 }
 

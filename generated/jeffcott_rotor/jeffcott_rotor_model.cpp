@@ -18,7 +18,7 @@ std::array<double, 5> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "jeffcott_rotor", "jeffcott_rotor", "full", jeffcott_rotor_abi_version(),
       2, 1, 2, 5, true, false, 0.0, 0.0,
       jeffcott_rotor_coordinate_names, coordinate_units, jeffcott_rotor_parameter_names, parameter_units, jeffcott_rotor_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       jeffcott_rotor_n_sensitivity_parameters, jeffcott_rotor_sensitivity_parameter_names, &jeffcott_rotor_sensitivity, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = jeffcott_rotor_n_checks;
+    with_checks.check_kinds = jeffcott_rotor_check_kinds;
+    with_checks.check_labels = jeffcott_rotor_check_labels;
+    with_checks.check_units = jeffcott_rotor_check_units;
+    with_checks.check_parameters = jeffcott_rotor_check_parameters;
+    with_checks.physical = &jeffcott_rotor_physical;
+    return with_checks;
+  }();
   return k;
 }
 

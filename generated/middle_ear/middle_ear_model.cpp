@@ -18,7 +18,7 @@ std::array<double, 87> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "middle_ear", "middle_ear", "full", middle_ear_abi_version(),
       18, 7, 12, 87, true, false, 0.0, 0.0,
       middle_ear_coordinate_names, coordinate_units, middle_ear_parameter_names, parameter_units, middle_ear_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       middle_ear_input_kinds, &middle_ear_excitation,
       middle_ear_n_sensitivity_parameters, middle_ear_sensitivity_parameter_names, &middle_ear_sensitivity, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = middle_ear_n_checks;
+    with_checks.check_kinds = middle_ear_check_kinds;
+    with_checks.check_labels = middle_ear_check_labels;
+    with_checks.check_units = middle_ear_check_units;
+    with_checks.check_parameters = middle_ear_check_parameters;
+    with_checks.physical = &middle_ear_physical;
+    return with_checks;
+  }();
   return k;
 }
 

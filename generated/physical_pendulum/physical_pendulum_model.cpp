@@ -18,7 +18,7 @@ std::array<double, 3> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "physical_pendulum", "physical_pendulum", "full", physical_pendulum_abi_version(),
       1, 0, 1, 3, true, false, 0.0, 0.0,
       physical_pendulum_coordinate_names, coordinate_units, physical_pendulum_parameter_names, parameter_units, physical_pendulum_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       physical_pendulum_n_sensitivity_parameters, physical_pendulum_sensitivity_parameter_names, &physical_pendulum_sensitivity, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = physical_pendulum_n_checks;
+    with_checks.check_kinds = physical_pendulum_check_kinds;
+    with_checks.check_labels = physical_pendulum_check_labels;
+    with_checks.check_units = physical_pendulum_check_units;
+    with_checks.check_parameters = physical_pendulum_check_parameters;
+    with_checks.physical = &physical_pendulum_physical;
+    return with_checks;
+  }();
   return k;
 }
 

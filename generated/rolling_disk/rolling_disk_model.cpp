@@ -18,7 +18,7 @@ std::array<double, 4> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "rolling_disk", "rolling_disk", "full", rolling_disk_abi_version(),
       5, 0, 1, 4, false, false, 0.0, 0.0,
       rolling_disk_coordinate_names, coordinate_units, rolling_disk_parameter_names, parameter_units, rolling_disk_parameter_defaults,
@@ -26,6 +26,16 @@ const mbsgen::ModelKernels& kernels() {
       &rolling_disk_operating_point, nullptr, nullptr, nullptr,
       0, false, "0.1.0", nullptr, &rolling_disk_outputs,
       3, rolling_disk_speed_names, &rolling_disk_descriptor, 2, rolling_disk_reduced_coordinate_names, &rolling_disk_reduced, 0, rolling_disk_reduced_part_names, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = rolling_disk_n_checks;
+    with_checks.check_kinds = rolling_disk_check_kinds;
+    with_checks.check_labels = rolling_disk_check_labels;
+    with_checks.check_units = rolling_disk_check_units;
+    with_checks.check_parameters = rolling_disk_check_parameters;
+    with_checks.physical = &rolling_disk_physical;
+    return with_checks;
+  }();
   return k;
 }
 

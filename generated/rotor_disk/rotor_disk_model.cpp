@@ -18,7 +18,7 @@ std::array<double, 5> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "rotor_disk", "rotor_disk", "full", rotor_disk_abi_version(),
       3, 1, 2, 5, false, false, 0.0, 0.0,
       rotor_disk_coordinate_names, coordinate_units, rotor_disk_parameter_names, parameter_units, rotor_disk_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       rotor_disk_n_sensitivity_parameters, rotor_disk_sensitivity_parameter_names, &rotor_disk_sensitivity, &rotor_disk_operating_point_sensitivity};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = rotor_disk_n_checks;
+    with_checks.check_kinds = rotor_disk_check_kinds;
+    with_checks.check_labels = rotor_disk_check_labels;
+    with_checks.check_units = rotor_disk_check_units;
+    with_checks.check_parameters = rotor_disk_check_parameters;
+    with_checks.physical = &rotor_disk_physical;
+    return with_checks;
+  }();
   return k;
 }
 

@@ -18,7 +18,7 @@ std::array<double, 5> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "rotor_disk_motion", "rotor_disk", "motion", rotor_disk_motion_abi_version(),
       3, 1, 2, 5, true, false, 0.0, 0.0,
       rotor_disk_motion_coordinate_names, coordinate_units, rotor_disk_motion_parameter_names, parameter_units, rotor_disk_motion_parameter_defaults,
@@ -27,6 +27,16 @@ const mbsgen::ModelKernels& kernels() {
       0, false, "0.1.0", nullptr, &rotor_disk_motion_outputs,
       0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
       &rotor_disk_motion_dynamics, &rotor_disk_motion_dynamics_jacobian, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = rotor_disk_motion_n_checks;
+    with_checks.check_kinds = rotor_disk_motion_check_kinds;
+    with_checks.check_labels = rotor_disk_motion_check_labels;
+    with_checks.check_units = rotor_disk_motion_check_units;
+    with_checks.check_parameters = rotor_disk_motion_check_parameters;
+    with_checks.physical = &rotor_disk_motion_physical;
+    return with_checks;
+  }();
   return k;
 }
 

@@ -18,7 +18,7 @@ std::array<double, 4> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "shaken_pendulum", "shaken_pendulum", "full", shaken_pendulum_abi_version(),
       1, 3, 9, 4, true, false, 0.0, 0.0,
       shaken_pendulum_coordinate_names, coordinate_units, shaken_pendulum_parameter_names, parameter_units, shaken_pendulum_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       shaken_pendulum_input_kinds, &shaken_pendulum_excitation,
       shaken_pendulum_n_sensitivity_parameters, shaken_pendulum_sensitivity_parameter_names, &shaken_pendulum_sensitivity, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = shaken_pendulum_n_checks;
+    with_checks.check_kinds = shaken_pendulum_check_kinds;
+    with_checks.check_labels = shaken_pendulum_check_labels;
+    with_checks.check_units = shaken_pendulum_check_units;
+    with_checks.check_parameters = shaken_pendulum_check_parameters;
+    with_checks.physical = &shaken_pendulum_physical;
+    return with_checks;
+  }();
   return k;
 }
 

@@ -18,7 +18,7 @@ std::array<double, 3> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "simple_pendulum", "simple_pendulum", "full", simple_pendulum_abi_version(),
       1, 0, 2, 3, true, false, 0.0, 0.0,
       simple_pendulum_coordinate_names, coordinate_units, simple_pendulum_parameter_names, parameter_units, simple_pendulum_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       simple_pendulum_n_sensitivity_parameters, simple_pendulum_sensitivity_parameter_names, &simple_pendulum_sensitivity, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = simple_pendulum_n_checks;
+    with_checks.check_kinds = simple_pendulum_check_kinds;
+    with_checks.check_labels = simple_pendulum_check_labels;
+    with_checks.check_units = simple_pendulum_check_units;
+    with_checks.check_parameters = simple_pendulum_check_parameters;
+    with_checks.physical = &simple_pendulum_physical;
+    return with_checks;
+  }();
   return k;
 }
 

@@ -18,7 +18,7 @@ std::array<double, 6> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "sleeping_top", "sleeping_top", "full", sleeping_top_abi_version(),
       3, 0, 1, 6, false, false, 0.0, 0.0,
       sleeping_top_coordinate_names, coordinate_units, sleeping_top_parameter_names, parameter_units, sleeping_top_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       sleeping_top_n_sensitivity_parameters, sleeping_top_sensitivity_parameter_names, &sleeping_top_sensitivity, &sleeping_top_operating_point_sensitivity};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = sleeping_top_n_checks;
+    with_checks.check_kinds = sleeping_top_check_kinds;
+    with_checks.check_labels = sleeping_top_check_labels;
+    with_checks.check_units = sleeping_top_check_units;
+    with_checks.check_parameters = sleeping_top_check_parameters;
+    with_checks.physical = &sleeping_top_physical;
+    return with_checks;
+  }();
   return k;
 }
 

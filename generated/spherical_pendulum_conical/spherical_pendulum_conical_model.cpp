@@ -18,7 +18,7 @@ std::array<double, 3> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "spherical_pendulum_conical", "spherical_pendulum_conical", "full", spherical_pendulum_conical_abi_version(),
       2, 0, 2, 3, false, false, 0.0, 0.0,
       spherical_pendulum_conical_coordinate_names, coordinate_units, spherical_pendulum_conical_parameter_names, parameter_units, spherical_pendulum_conical_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       spherical_pendulum_conical_n_sensitivity_parameters, spherical_pendulum_conical_sensitivity_parameter_names, &spherical_pendulum_conical_sensitivity, &spherical_pendulum_conical_operating_point_sensitivity};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = spherical_pendulum_conical_n_checks;
+    with_checks.check_kinds = spherical_pendulum_conical_check_kinds;
+    with_checks.check_labels = spherical_pendulum_conical_check_labels;
+    with_checks.check_units = spherical_pendulum_conical_check_units;
+    with_checks.check_parameters = spherical_pendulum_conical_check_parameters;
+    with_checks.physical = &spherical_pendulum_conical_physical;
+    return with_checks;
+  }();
   return k;
 }
 

@@ -18,7 +18,7 @@ std::array<double, 3> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "spring_chain_fixed_fixed", "spring_chain_fixed_fixed", "full", spring_chain_fixed_fixed_abi_version(),
       5, 0, 1, 3, true, true, 0.0, 0.0,
       spring_chain_fixed_fixed_coordinate_names, coordinate_units, spring_chain_fixed_fixed_parameter_names, parameter_units, spring_chain_fixed_fixed_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       spring_chain_fixed_fixed_n_sensitivity_parameters, spring_chain_fixed_fixed_sensitivity_parameter_names, &spring_chain_fixed_fixed_sensitivity, &spring_chain_fixed_fixed_operating_point_sensitivity};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = spring_chain_fixed_fixed_n_checks;
+    with_checks.check_kinds = spring_chain_fixed_fixed_check_kinds;
+    with_checks.check_labels = spring_chain_fixed_fixed_check_labels;
+    with_checks.check_units = spring_chain_fixed_fixed_check_units;
+    with_checks.check_parameters = spring_chain_fixed_fixed_check_parameters;
+    with_checks.physical = &spring_chain_fixed_fixed_physical;
+    return with_checks;
+  }();
   return k;
 }
 

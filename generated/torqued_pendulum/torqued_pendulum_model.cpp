@@ -18,7 +18,7 @@ std::array<double, 5> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "torqued_pendulum", "torqued_pendulum", "full", torqued_pendulum_abi_version(),
       1, 1, 2, 5, true, true, 0.0, 0.0,
       torqued_pendulum_coordinate_names, coordinate_units, torqued_pendulum_parameter_names, parameter_units, torqued_pendulum_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       torqued_pendulum_n_sensitivity_parameters, torqued_pendulum_sensitivity_parameter_names, &torqued_pendulum_sensitivity, &torqued_pendulum_operating_point_sensitivity};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = torqued_pendulum_n_checks;
+    with_checks.check_kinds = torqued_pendulum_check_kinds;
+    with_checks.check_labels = torqued_pendulum_check_labels;
+    with_checks.check_units = torqued_pendulum_check_units;
+    with_checks.check_parameters = torqued_pendulum_check_parameters;
+    with_checks.physical = &torqued_pendulum_physical;
+    return with_checks;
+  }();
   return k;
 }
 

@@ -18,7 +18,7 @@ std::array<double, 27> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "whipple_benchmark", "whipple_benchmark", "full", whipple_benchmark_abi_version(),
       7, 2, 2, 27, false, false, 0.0, 0.0,
       whipple_benchmark_coordinate_names, coordinate_units, whipple_benchmark_parameter_names, parameter_units, whipple_benchmark_parameter_defaults,
@@ -29,6 +29,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr,
       whipple_benchmark_n_tree_coordinates, whipple_benchmark_n_constraints, &whipple_benchmark_assemble, &whipple_benchmark_constraints,
       &whipple_benchmark_assemble_from, nullptr, &whipple_benchmark_outputs_full, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = whipple_benchmark_n_checks;
+    with_checks.check_kinds = whipple_benchmark_check_kinds;
+    with_checks.check_labels = whipple_benchmark_check_labels;
+    with_checks.check_units = whipple_benchmark_check_units;
+    with_checks.check_parameters = whipple_benchmark_check_parameters;
+    with_checks.physical = &whipple_benchmark_physical;
+    return with_checks;
+  }();
   return k;
 }
 

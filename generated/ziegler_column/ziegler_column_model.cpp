@@ -18,7 +18,7 @@ std::array<double, 5> Parameters::values() const {
 }
 
 const mbsgen::ModelKernels& kernels() {
-  static const mbsgen::ModelKernels k{
+  static const mbsgen::ModelKernels base{
       "ziegler_column", "ziegler_column", "full", ziegler_column_abi_version(),
       2, 0, 1, 5, true, false, 0.0, 0.0,
       ziegler_column_coordinate_names, coordinate_units, ziegler_column_parameter_names, parameter_units, ziegler_column_parameter_defaults,
@@ -31,6 +31,16 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr, nullptr,
       nullptr, nullptr,
       ziegler_column_n_sensitivity_parameters, ziegler_column_sensitivity_parameter_names, &ziegler_column_sensitivity, nullptr};
+  static const mbsgen::ModelKernels k = [] {
+    mbsgen::ModelKernels with_checks = base;
+    with_checks.n_checks = ziegler_column_n_checks;
+    with_checks.check_kinds = ziegler_column_check_kinds;
+    with_checks.check_labels = ziegler_column_check_labels;
+    with_checks.check_units = ziegler_column_check_units;
+    with_checks.check_parameters = ziegler_column_check_parameters;
+    with_checks.physical = &ziegler_column_physical;
+    return with_checks;
+  }();
   return k;
 }
 

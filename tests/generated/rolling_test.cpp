@@ -251,3 +251,44 @@ TEST(RollingDisk, ZerosAreStructuralAndBoundsMeanSomething) {
 }
 
 }  // namespace
+
+// Run-time parameter values meet the model file's conditions (issue 39 §1): a negative wheel
+// radius was used by `modes` (eigenvalues printed), and a -2 kg rear wheel passed every check
+// (the bicycle's assembled mass matrix stays definite against the 85 kg rider). Each refusal
+// names the element, its value and the parameters with their values; the defaults pass.
+TEST(PhysicalChecks, RunTimeParametersMeetTheModelFilesConditions) {
+  auto refusal = [](const mbsgen::ModelKernels& k, const std::vector<std::string>& sets) -> std::string {
+    GeneratedModel model(k);
+    for (const auto& s : sets) model.set(s);
+    try {
+      (void)model.descriptor_model();
+    } catch (const mbsgen::ParameterError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(refusal(rolling_disk::kernels(), {}), "");
+  EXPECT_EQ(refusal(whipple_benchmark::kernels(), {}), "");
+  EXPECT_EQ(refusal(rolling_disk::kernels(), {"r=-1"}),
+            "model 'rolling_disk': with these parameter values (r = -1) the wheel radius of rolling constraint "
+            "'contact' is -1 m; it must be > 0");
+  EXPECT_NE(refusal(rolling_disk::kernels(), {"r=0"}).find("is 0 m; it must be > 0"), std::string::npos);
+  // The rear wheel's mass: negative; zero with the wheel's inertia left.
+  EXPECT_NE(refusal(whipple_benchmark::kernels(), {"mR=-2"}).find("(mR = -2, IRxx = 0.0603, IRyy = 0.12) body 'rear_wheel' has mass -2 kg; a mass must be >= 0"),
+            std::string::npos);
+  EXPECT_NE(refusal(whipple_benchmark::kernels(), {"mR=0"}).find("body 'rear_wheel' has zero mass but a nonzero inertia"),
+            std::string::npos);
+  // The rear frame's product of inertia beyond sqrt(IBxx IBzz) = 5.08: not semi-definite.
+  EXPECT_NE(refusal(whipple_benchmark::kernels(), {"IBxz=6"}).find("IBxz = 6) body 'rear_frame' has an inertia tensor that is "
+                                                                   "not positive semi-definite"),
+            std::string::npos);
+  // A wheel whose polar moment exceeds the sum of the others (IRyy > 2 IRxx): no mass distribution.
+  const std::string triangle = refusal(whipple_benchmark::kernels(), {"IRyy=0.2"});
+  EXPECT_NE(triangle.find("body 'rear_wheel' has an inertia tensor that violates the triangle inequality"), std::string::npos)
+      << triangle;
+  EXPECT_EQ(refusal(whipple_benchmark::kernels(), {"IRyy=0.1206"}), "");  // = 2 IRxx: a flat disk, allowed
+  // Several values judged together: a zero-mass wheel with zero inertia is a massless frame.
+  GeneratedModel massless(whipple_benchmark::kernels());
+  for (const char* s : {"mR=0", "IRxx=0", "IRyy=0"}) massless.set(s);
+  EXPECT_NO_THROW(massless.check_parameters());
+}

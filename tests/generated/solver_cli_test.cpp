@@ -80,14 +80,23 @@ TEST(GeneratedModel, SetByNameAndErrors) {
   EXPECT_THROW(m.output_index("nope"), mbsgen::NameError);
 }
 
-// A negative mass makes M indefinite: an error naming the mass matrix, not eigenvalues that look
-// like results (M of the double pendulum with m1 = −3, m2 = 1: [[−2, 1], [1, 1]], eigenvalues
-// −2.30 and 1.30).
+// A negative mass is refused before any analysis by the model file's condition on the body
+// (ParameterError, exit 2); behind it, an indefinite M is still an error naming the mass matrix,
+// not eigenvalues that look like results (M of the double pendulum with m1 = −3, m2 = 1:
+// [[−2, 1], [1, 1]], eigenvalues −2.30 and 1.30), for an operating point taken before the change.
 TEST(GeneratedModel, IndefiniteMassMatrixIsAnError) {
   mbsgen::GeneratedModel m(double_pendulum::kernels());
+  const mbsgen::OperatingPoint op = m.operating_point();
   m.set("m1=-3");
   try {
     (void)m.linear_model();
+    FAIL() << "a negative mass was accepted";
+  } catch (const mbsgen::ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("(m1 = -3) body 'rod1' has mass -3 kg; a mass must be >= 0"), std::string::npos)
+        << e.what();
+  }
+  try {
+    (void)m.linear_model(op);
     FAIL() << "an indefinite M was accepted";
   } catch (const mbsgen::Error& e) {
     EXPECT_NE(std::string(e.what()).find("not positive semi-definite"), std::string::npos) << e.what();
@@ -96,8 +105,8 @@ TEST(GeneratedModel, IndefiniteMassMatrixIsAnError) {
   m.set("m1=0");  // semi-definite (a massless first rod end): allowed, infinite eigenvalues follow
   EXPECT_NO_THROW((void)m.linear_model());
   std::string err;
-  EXPECT_EQ(solve({"modes", "--set", "m1=-3"}, nullptr, &err), 1);
-  EXPECT_NE(err.find("not positive semi-definite"), std::string::npos) << err;
+  EXPECT_EQ(solve({"modes", "--set", "m1=-3"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("body 'rod1' has mass -3 kg"), std::string::npos) << err;
 }
 
 int solve(std::vector<std::string> args, std::string* out_text, std::string* err_text) {

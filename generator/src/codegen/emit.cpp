@@ -274,6 +274,10 @@ std::vector<ex> column_major(const ExMatrix& A, std::size_t rows, std::size_t co
 std::string json_string(const std::string& s) { return json_string_literal(s); }
 
 // Whether the code has the sensitivity kernel (its parameters' names go to the header and source).
+bool has_kernel(const GeneratedCode& out, const std::string& name) {
+  return std::any_of(out.kernels.begin(), out.kernels.end(), [&](const KernelInfo& k) { return k.name == name; });
+}
+
 bool has_sensitivity_kernel(const GeneratedCode& out) {
   return std::any_of(out.kernels.begin(), out.kernels.end(), [](const KernelInfo& k) { return k.name == "sensitivity"; });
 }
@@ -849,6 +853,13 @@ std::string header_text(const Model& model, const Equations& eq, const LinearEqu
     h << "// Parameter sensitivities: the parameters of the sensitivity kernel, in its order.\nenum { " << out.id
       << "_n_sensitivity_parameters = " << sensitivity_parameter_names(model).size() << " };\nextern const char* const "
       << out.id << "_sensitivity_parameter_names[];\n";
+  if (has_kernel(out, "physical"))
+    h << "// The physical conditions on the parameters: per check its kind (positive, nonnegative, body),\n"
+         "// what it is, the unit of its value, and the parameters it depends on (comma-separated); the\n"
+         "// physical kernel gives the values.\nenum { "
+      << out.id << "_n_checks = " << model.physical_checks().size() << " };\nextern const char* const " << out.id
+      << "_check_kinds[];\nextern const char* const " << out.id << "_check_labels[];\nextern const char* const "
+      << out.id << "_check_units[];\nextern const char* const " << out.id << "_check_parameters[];\n";
   if (loops)
     h << "// Closed loops: the kernels take the independent coordinates (coordinate_names); "
          "assemble\n// and the constraint kernels all " << n << " tree coordinates.\nenum { " << out.id
@@ -1133,6 +1144,13 @@ void sensitivity_kernels(const Model& model, Equations& eq, const LinearEquation
 // The kernels of docs/generator.md, in emission order. With closed loops the coordinates y are
 // the tree's (n), the rates yd the independent ones, and the matrices those of the independent
 // coordinates (f); such kernels are wrapped (Kernel::wrapped).
+// The values of Model::physical_checks, one check after the other (the `physical` kernel).
+std::vector<ex> physical_values(const Model& model) {
+  std::vector<ex> v;
+  for (const PhysicalCheck& c : model.physical_checks()) v.insert(v.end(), c.values.begin(), c.values.end());
+  return v;
+}
+
 std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const LinearEquations& lin, bool dynamics) {
   const bool loops = eq.loops.active;
   const std::size_t f = lin.M.size(), m = eq.u.size(), r = eq.outputs.size();
@@ -1200,10 +1218,15 @@ std::vector<Kernel> model_kernels(const Model& model, Equations& eq, const Linea
   }
   sensitivity_kernels(model, eq, lin, y, yd, p, kernels);
   kernels.push_back(bodies_kernel(eq, nb, y, p, f));
+  if (std::vector<ex> v = physical_values(model); !v.empty())
+    kernels.push_back({"physical",
+                       "the values of the model's physical conditions on the parameters (check_kinds, "
+                       "check_labels): a body's mass and Ixx, Iyy, Izz, Ixy, Ixz, Iyz, or one length",
+                       {{"p", p}}, {{"v", v, ""}}});
 
   if (loops)
     for (auto& k : kernels) {
-      k.wrapped = k.name != "operating_point";
+      k.wrapped = k.name != "operating_point" && k.name != "physical";  // functions of p alone
       k.full_public = k.name == "dynamics" || k.name == "outputs" || k.name == "outputs_general";
     }
   return kernels;
@@ -1595,6 +1618,19 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   if (has_sensitivity_kernel(out))
     c << names_array("sensitivity_parameter_names", sensitivity_parameter_names(model));
   if (loops) c << names_array("tree_coordinate_names", tree);
+  if (has_kernel(out, "physical")) {
+    std::vector<std::string> kinds_of_checks, labels, units, parameters;
+    for (const PhysicalCheck& check : model.physical_checks()) {
+      kinds_of_checks.push_back(to_string(check.kind));
+      labels.push_back(check.label);
+      units.push_back(check.unit);
+      std::string names;
+      for (const auto& name : check.parameters) names += (names.empty() ? "" : ",") + name;
+      parameters.push_back(names);
+    }
+    c << names_array("check_kinds", kinds_of_checks) << names_array("check_labels", labels)
+      << names_array("check_units", units) << names_array("check_parameters", parameters);
+  }
   if (lin.descriptor) {
     std::vector<std::string> sn;
     for (std::size_t k : lin.speeds) sn.push_back(model.coordinates()[k].name);

@@ -137,7 +137,8 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
   c << "std::array<double, " << pm.size() << "> Parameters::values() const {\n  return {";
   for (std::size_t i = 0; i < pm.size(); ++i) c << (i ? ", " : "") << pm[i];
   c << "};\n}\n\n";
-  c << "const mbsgen::ModelKernels& kernels() {\n  static const mbsgen::ModelKernels k{\n"
+  const bool checks = has_kernel(code, "physical");
+  c << "const mbsgen::ModelKernels& kernels() {\n  static const mbsgen::ModelKernels " << (checks ? "base" : "k") << "{\n"
     << "      " << literal(id) << ", " << literal(model.name()) << ", " << literal(scene) << ", " << id
     << "_abi_version(),\n      " << cn.size() << ", " << in.size() << ", " << on.size() << ", "
     << pn.size() << ", " << (lin.at_rest ? "true" : "false") << ", "
@@ -174,7 +175,15 @@ GeneratedApi emit_api(const Model& model, const LinearEquations& lin, const Gene
   if (sensitivity)
     c << ",\n      " << id << "_n_sensitivity_parameters, " << id << "_sensitivity_parameter_names, "
       << kernel("sensitivity") << ", " << kernel("operating_point_sensitivity");
-  c << "};\n  return k;\n}\n\n";
+  c << "};\n";
+  // The physical conditions on the parameters, set after the aggregate (ModelKernels' last fields).
+  if (checks)
+    c << "  static const mbsgen::ModelKernels k = [] {\n    mbsgen::ModelKernels with_checks = base;\n"
+      << "    with_checks.n_checks = " << id << "_n_checks;\n    with_checks.check_kinds = " << id
+      << "_check_kinds;\n    with_checks.check_labels = " << id << "_check_labels;\n    with_checks.check_units = " << id
+      << "_check_units;\n    with_checks.check_parameters = " << id << "_check_parameters;\n    with_checks.physical = "
+      << kernel("physical") << ";\n    return with_checks;\n  }();\n";
+  c << "  return k;\n}\n\n";
   c << "mbsgen::GeneratedModel model(const Parameters& p) {\n  mbsgen::GeneratedModel m(kernels());\n"
        "  const auto v = p.values();\n  m.set_parameters(std::vector<double>(v.begin(), v.end()));\n"
        "  return m;\n}\n\n";

@@ -816,4 +816,40 @@ void Model::validate() const {
   detail::check_force_directions(*this, exact_defaults);
 }
 
+const char* to_string(PhysicalCheck::Kind kind) {
+  switch (kind) {
+    case PhysicalCheck::Kind::positive: return "positive";
+    case PhysicalCheck::Kind::nonnegative: return "nonnegative";
+    case PhysicalCheck::Kind::body: return "body";
+  }
+  return "";
+}
+
+std::vector<PhysicalCheck> Model::physical_checks() const {
+  std::vector<PhysicalCheck> checks;
+  // A check of `values` when they depend on a parameter, naming those in the model's order.
+  auto add = [&](PhysicalCheck::Kind kind, std::string label, std::string unit, std::vector<GiNaC::ex> values) {
+    std::set<std::string> symbols;
+    for (const auto& v : values) collect_symbols(v, symbols);
+    PhysicalCheck c{kind, std::move(label), std::move(unit), {}, std::move(values)};
+    for (const auto& p : parameters_)
+      if (symbols.count(p.name)) c.parameters.push_back(p.name);
+    if (!c.parameters.empty()) checks.push_back(std::move(c));
+  };
+  for (const auto& b : bodies_) {
+    const Mat3& I = b.inertia;
+    add(PhysicalCheck::Kind::body, "body '" + b.name + "'", "",
+        {b.mass, I[0][0], I[1][1], I[2][2], I[0][1], I[0][2], I[1][2]});
+  }
+  for (const auto& c : constraints_) {
+    if (c.kind == ConstraintKind::distance)
+      add(PhysicalCheck::Kind::positive, "the length of distance constraint '" + c.name + "'", "m", {c.length});
+    if (c.kind == ConstraintKind::rolling)
+      add(PhysicalCheck::Kind::positive, "the wheel radius of rolling constraint '" + c.name + "'", "m", {c.length});
+  }
+  for (const auto& s : springs_)
+    add(PhysicalCheck::Kind::nonnegative, "the rest length of spring '" + s.name + "'", "m", {s.rest_length});
+  return checks;
+}
+
 }  // namespace mbsgen

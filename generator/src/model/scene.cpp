@@ -13,7 +13,7 @@ using GiNaC::ex;
 
 std::vector<std::string> SceneSelection::all_kernels() {
   return {"mass_matrix", "residual", "linear", "linear_structured", "operating_point", "outputs", "bodies", "dynamics",
-          "sensitivity"};
+          "sensitivity", "physical"};
 }
 
 bool SceneSelection::emits(const std::string& kernel) const {
@@ -266,7 +266,7 @@ void select_analyses(SceneSelection& sel, const Model& model, const Scene& scene
         if (it.name == p.name) sel.sensitivity_parameters.push_back(p.name);
   sel.kernels.clear();
   for (const auto& k : SceneSelection::all_kernels()) {
-    bool used = k == "operating_point";
+    bool used = k == "operating_point" || k == "physical";  // every analysis checks the parameters
     for (Analysis a : sel.analyses) {
       const auto ks = kernels_of(a);
       used = used || std::find(ks.begin(), ks.end(), k) != ks.end();

@@ -44,7 +44,69 @@ void check_status(int status, const char* kernel, const std::string& model) {
                          "' returned a non-finite value (check the parameters)");
 }
 
+// %.6g: a value in a message.
+std::string g6(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// Why a body's mass m and inertia tensor (Ixx, Iyy, Izz, Ixy, Ixz, Iyz at v) are no mass
+// distribution's, or "". The conditions of the model file's check (generator model.cpp,
+// inertia_problem): m >= 0; the principal moments A <= B <= C >= 0 with A + B >= C (equality for a
+// flat body), within 32 ε max|d| for the rounding of the entries and of the eigensolver; a zero
+// mass with a zero tensor.
+std::string body_problem(const double* v) {
+  if (v[0] < 0) return "has mass " + g6(v[0]) + " kg; a mass must be >= 0";
+  Eigen::Matrix3d J;
+  J << v[1], v[4], v[5], v[4], v[2], v[6], v[5], v[6], v[3];
+  if (v[0] == 0 && !J.isZero(0)) return "has zero mass but a nonzero inertia tensor (give it a mass, or zero inertia)";
+  const Eigen::Vector3d d = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(J, Eigen::EigenvaluesOnly).eigenvalues();
+  const double tol = 32 * std::numeric_limits<double>::epsilon() * d.cwiseAbs().maxCoeff();
+  const std::string moments = "principal moments " + g6(d(0)) + ", " + g6(d(1)) + ", " + g6(d(2)) + " kg m^2";
+  if (d(0) < -tol) return "has an inertia tensor that is not positive semi-definite (" + moments + ")";
+  if (d(0) + d(1) - d(2) < -2 * tol)
+    return "has an inertia tensor that violates the triangle inequality (" + moments +
+           ": A + B < C, which no mass distribution gives)";
+  return "";
+}
+
 }  // namespace
+
+void GeneratedModel::check_parameters() const {
+  if (!k_.physical || k_.n_checks <= 0) return;
+  std::size_t count = 0;
+  for (int c = 0; c < k_.n_checks; ++c) count += std::string(k_.check_kinds[c]) == "body" ? 7 : 1;
+  std::vector<double> v(count);
+  check_status(k_.physical(p_.data(), v.data()), "physical", k_.model);
+  const double* x = v.data();
+  for (int c = 0; c < k_.n_checks; ++c) {
+    const std::string kind = k_.check_kinds[c], label = k_.check_labels[c];
+    std::string problem;
+    if (kind == "body") {
+      problem = body_problem(x);
+      x += 7;
+    } else {
+      const bool positive = kind == "positive";
+      const double value = *x++;
+      const std::string unit = k_.check_units && k_.check_units[c] && *k_.check_units[c] ? std::string(" ") + k_.check_units[c] : "";
+      if (positive ? !(value > 0) : !(value >= 0))
+        problem = "is " + g6(value) + unit + "; it must be " + (positive ? "> 0" : ">= 0");
+    }
+    if (problem.empty()) continue;
+    // The parameters it depends on, with their values.
+    std::string values, names = k_.check_parameters[c];
+    for (std::size_t start = 0; start <= names.size();) {
+      const std::size_t end = std::min(names.find(',', start), names.size());
+      const std::string name = names.substr(start, end - start);
+      for (std::size_t i = 0; i < parameter_names_.size(); ++i)
+        if (parameter_names_[i] == name) values += (values.empty() ? "" : ", ") + name + " = " + g6(p_[i]);
+      start = end + 1;
+    }
+    throw ParameterError("model '" + std::string(k_.model) + "': with these parameter values (" + values + ") " +
+                         label + " " + problem);
+  }
+}
 
 std::vector<std::string> name_list(const char* const* list, int n) {
   std::vector<std::string> v;
@@ -118,6 +180,7 @@ OperatingPoint GeneratedModel::operating_point() const {
   OperatingPoint op;
   op.y0.setZero(f);
   op.yd0.setZero(f);
+  check_parameters();
   check_status(k_.operating_point(p_.data(), op.y0.data(), op.yd0.data()), "operating_point", k_.model);
   if (!k_.residual) {
     op.report = "given by the model";
@@ -197,6 +260,7 @@ Eigen::VectorXd GeneratedModel::outputs_at(const Eigen::VectorXd& y, const Eigen
     throw Error(std::string(who) + ": model '" + k_.model + "' has nonholonomic constraints: its coordinate rates "
                 "are not free, and a state that violates the velocity constraints would give outputs that mean "
                 "nothing (the outputs at the operating point: outputs(operating_point()))");
+  check_parameters();
   const Eigen::Index f = size(), m = k_.n_inputs;
   if (y.size() != f || yd.size() != f || ydd.size() != f || u.size() != m)
     throw DimensionError(std::string(who) + ": y, yd, ydd, u of sizes " + std::to_string(y.size()) + "/" +

@@ -53,12 +53,17 @@ SweepPoint spectrum(const GeneratedModel& model, double value) {
 
 SweepPoint at(GeneratedModel& model, const std::string& parameter, double value) {
   model.set(parameter, value);
-  try {
-    return spectrum(model, value);
-  } catch (const Error& e) {
+  const auto where = [&](const Error& e) {
     std::ostringstream s;
     s << "sweep of " << parameter << ": at " << parameter << " = " << value << ": " << e.what();
-    throw Error(s.str());
+    return s.str();
+  };
+  try {
+    return spectrum(model, value);
+  } catch (const ParameterError& e) {  // a value the model file's conditions refuse: the user's
+    throw ParameterError(where(e));
+  } catch (const Error& e) {
+    throw Error(where(e));
   }
 }
 

@@ -216,7 +216,7 @@ TEST(Scenes, PrunedModel) {
   EXPECT_TRUE(undamped.bushings()[0].d_translation[0].is_zero());
   EXPECT_FALSE(undamped.bushings()[0].k_translation[0].is_zero());
   EXPECT_FALSE(undamped.inertial_velocity_terms());
-  EXPECT_EQ(undamped.selection().kernels, (std::vector<std::string>{"linear", "linear_structured", "operating_point"}));
+  EXPECT_EQ(undamped.selection().kernels, (std::vector<std::string>{"linear", "linear_structured", "operating_point", "physical"}));
 
   const Model rotor = read_model_file(kSourceDir + "/models/textbook/rotor_disk.yaml");
   const Model spinning = apply_scene(rotor, "spinning");
@@ -239,14 +239,14 @@ TEST(Scenes, SimulateKeepsWhatATimeStepNeeds) {
   const Model motion = apply_scene(rotor, "motion");
   EXPECT_TRUE(motion.inertial_velocity_terms());
   EXPECT_EQ(motion.selection().kernels,
-            (std::vector<std::string>{"mass_matrix", "residual", "operating_point", "outputs", "dynamics"}));
+            (std::vector<std::string>{"mass_matrix", "residual", "operating_point", "outputs", "dynamics", "physical"}));
   EXPECT_EQ(motion.inputs().size(), rotor.inputs().size());
   EXPECT_EQ(motion.outputs().size(), rotor.outputs().size());
   const Generated g = generate(rotor, "motion");
   std::set<std::string> names;
   for (const auto& k : g.code.kernels) names.insert(k.name);
   EXPECT_EQ(names, (std::set<std::string>{"mass_matrix", "residual", "dynamics", "dynamics_jacobian",
-                                          "operating_point", "outputs"}));
+                                          "operating_point", "outputs", "physical"}));
 
   Model rest = apply_scene(rotor, "modes_at_rest");
   Equations eq = derive(rest);
@@ -272,7 +272,7 @@ TEST(Scenes, SimulateKeepsWhatATimeStepNeeds) {
   }
   const Model swing = apply_scene(read_model_string(text, "four_bar.yaml"), "swing");
   EXPECT_EQ(swing.selection().kernels,
-            (std::vector<std::string>{"mass_matrix", "residual", "linear", "operating_point", "outputs", "dynamics"}));
+            (std::vector<std::string>{"mass_matrix", "residual", "linear", "operating_point", "outputs", "dynamics", "physical"}));
 }
 
 TEST(Scenes, UnknownSceneNamesTheKnownOnes) {

@@ -649,3 +649,39 @@ TEST(Linkages, DocumentationFourBarReads) {
   for (std::size_t i = 0; i < m.parameters().size(); ++i)
     EXPECT_EQ(m.parameters()[i].value, file.parameters()[i].value) << m.parameters()[i].name;
 }
+
+// The model file's conditions on masses, inertias, lengths and radii that depend on parameters
+// are listed for the run time (Model::physical_checks, issue 39 §1); those on constants were
+// decided by validate() and are not. The Whipple bicycle: four bodies with parameter masses
+// (the two massless frames are constant), two wheel radii; none of the values is changed.
+TEST(PhysicalChecks, EveryParameterDependentConditionIsListed) {
+  const mbsgen::Model bike = mbsgen::read_model_file(kSourceDir + "/models/bicycle/whipple_benchmark.yaml");
+  const std::vector<mbsgen::PhysicalCheck> checks = bike.physical_checks();
+  std::vector<std::string> labels;
+  for (const auto& c : checks) labels.push_back(c.label);
+  EXPECT_EQ(labels, (std::vector<std::string>{"body 'rear_frame'", "body 'rear_wheel'", "body 'front_frame'",
+                                               "body 'front_wheel'", "the wheel radius of rolling constraint 'rear_contact'",
+                                               "the wheel radius of rolling constraint 'front_contact'"}));
+  ASSERT_EQ(checks.size(), 6u);
+  EXPECT_EQ(checks[1].kind, mbsgen::PhysicalCheck::Kind::body);
+  // Each parameter of the rear wheel's values once (in the model file's parameter order).
+  std::vector<std::string> rear = checks[1].parameters;
+  std::sort(rear.begin(), rear.end());
+  EXPECT_EQ(rear, (std::vector<std::string>{"IRxx", "IRyy", "mR"}));
+  ASSERT_EQ(checks[1].values.size(), 7u);
+  EXPECT_TRUE(same(checks[1].values[0], bike.symbol("mR")));
+  EXPECT_TRUE(same(checks[1].values[3], bike.symbol("IRxx")));  // zz: IRxx
+  EXPECT_TRUE(same(checks[1].values[4], 0));                    // no xy product
+  EXPECT_EQ(checks[4].kind, mbsgen::PhysicalCheck::Kind::positive);
+  EXPECT_EQ(checks[4].parameters, std::vector<std::string>{"rR"});
+  EXPECT_EQ(checks[4].unit, "m");
+  // A spring's rest length: nonnegative; the physical pendulum's m l^2/12 names both parameters.
+  const mbsgen::Model chain = mbsgen::read_model_file(kSourceDir + "/models/textbook/spring_chain_fixed_free.yaml");
+  bool rest = false;
+  for (const auto& c : chain.physical_checks())
+    rest = rest || (c.kind == mbsgen::PhysicalCheck::Kind::nonnegative && c.parameters == std::vector<std::string>{"a"});
+  EXPECT_TRUE(rest);
+  const mbsgen::Model rod = mbsgen::read_model_file(kSourceDir + "/models/textbook/physical_pendulum.yaml");
+  ASSERT_EQ(rod.physical_checks().size(), 1u);
+  EXPECT_EQ(rod.physical_checks()[0].parameters, (std::vector<std::string>{"m", "l"}));
+}

@@ -385,6 +385,22 @@ struct CallSite {
   SourceLocation where;
 };
 
+/// A condition on the parameters that the model file's checks impose (Model::validate) and that a
+/// parameter value given at run time must meet too: the generator emits the values as the
+/// `physical` kernel, and GeneratedModel judges them before each analysis (issue 39 §1).
+struct PhysicalCheck {
+  /// positive: one value > 0 (a rod length, a wheel radius); nonnegative: one value >= 0 (a
+  /// spring's rest length); body: seven values, the mass and the inertia tensor's Ixx, Iyy, Izz,
+  /// Ixy, Ixz, Iyz (mass >= 0, tensor positive semi-definite with A + B >= C, zero with the mass).
+  enum class Kind { positive, nonnegative, body };
+  Kind kind = Kind::positive;
+  std::string label;                    ///< what the values are: "body 'wheel'", "radius of rolling constraint 'c'"
+  std::string unit;                     ///< of a positive or nonnegative value
+  std::vector<std::string> parameters;  ///< the parameters the values depend on, in the model's order
+  std::vector<GiNaC::ex> values;
+};
+const char* to_string(PhysicalCheck::Kind kind);
+
 class Model;
 /// The model as one of its scenes sees it (scene.hpp).
 Model apply_scene(const Model& model, const std::string& scene);
@@ -507,6 +523,10 @@ class Model {
   /// or damper joins two coincident points. Throws ModelError at the offending element (at the
   /// call, when add_call_site recorded it).
   void validate() const;
+  /// The conditions of validate() on masses, inertia tensors, rod lengths, wheel radii and rest
+  /// lengths whose values depend on parameters (those that do not were decided by validate()),
+  /// in the order bodies, constraints, springs.
+  std::vector<PhysicalCheck> physical_checks() const;
 
  private:
   friend Model apply_scene(const Model& model, const std::string& scene);

@@ -129,6 +129,18 @@ struct ModelKernels {
                      double* dD, double* dB1, double* dB2, double* dD1) = nullptr;
   int (*operating_point_sensitivity)(const double* y0, const double* yd0, const double* p, double* dy0,
                                      double* dyd0) = nullptr;
+  /// The model file's physical conditions on the parameters (issue 39 §1; null, 0: none depend
+  /// on a parameter, or generated before them): per check its kind ("positive": one value > 0;
+  /// "nonnegative": one value >= 0; "body": seven values, mass, Ixx, Iyy, Izz, Ixy, Ixz, Iyz — a
+  /// mass >= 0 and an inertia tensor of a mass distribution), its label ("body 'wheel'"), the unit
+  /// of a one-value check, and the parameters it depends on (comma-separated); `physical` gives
+  /// the values, one check after the other. GeneratedModel::check_parameters judges them. Trailing.
+  int n_checks = 0;
+  const char* const* check_kinds = nullptr;
+  const char* const* check_labels = nullptr;
+  const char* const* check_units = nullptr;
+  const char* const* check_parameters = nullptr;
+  int (*physical)(const double* p, double* v) = nullptr;
 };
 
 /// True when input j of the kernels prescribes motion (input_kinds, prescribed motion).
@@ -144,6 +156,13 @@ std::vector<std::string> name_list(const char* const* names, int n);
 class NameError : public Error {
  public:
   using Error::Error;
+};
+
+/// A parameter value that breaks one of the model file's physical conditions (a negative mass or
+/// wheel radius, an inertia tensor no mass distribution has): a bad value from the user.
+class ParameterError : public NameError {
+ public:
+  using NameError::NameError;
 };
 
 /// The operating point of a GeneratedModel.
@@ -184,8 +203,17 @@ class GeneratedModel {
   Eigen::Index input_index(const std::string& name) const;
   Eigen::Index output_index(const std::string& name) const;
 
+  /// Throws ParameterError when the parameter values break one of the model file's physical
+  /// conditions (ModelKernels::physical: masses >= 0, inertia tensors positive semi-definite with
+  /// A + B >= C and zero with a zero mass, rod lengths and wheel radii > 0, rest lengths >= 0),
+  /// naming the element, its value and the parameters it depends on with their values. Judged
+  /// here, not by set(), so that several values set together are judged together;
+  /// operating_point() calls it, so every analysis does.
+  void check_parameters() const;
+
   /// The operating point: given by the model, or a static equilibrium from the model's initial
   /// guess (Newton with line search on the residual kernel, Jacobian K from the linear kernel).
+  /// Checks the parameters first (check_parameters).
   /// Throws ConvergenceError or SingularSystemError when no equilibrium is found, NonFiniteError
   /// when a kernel returns a non-finite value.
   OperatingPoint operating_point() const;
