@@ -1,5 +1,5 @@
 # mbsgen_add_model(<target> MODEL <file> [SCENE <name>] [SOLVER] [OUTPUT_DIR <dir>] [ID <id>]
-#                  [PARTS <n>] [DYNAMICS])
+#                  [PARTS <n>] [DYNAMICS] [SENSITIVITY] [SENSITIVITY_PARAMETERS <name>...])
 #
 # Generates a model's kernels at build time and compiles them into the static library <target>,
 # linked to mbsgen::runtime, with the typed C++ API <id>_model.hpp (namespace <id>: Parameters
@@ -20,12 +20,16 @@
 #   DYNAMICS    also emit the kernels of a time step (the solver's `simulate`): <id>_dynamics(y,
 #               yd, u, p, M, r), M and k − q in one kernel, and <id>_dynamics_jacobian(y, yd,
 #               ydd, u, p, Ky, Kv) (the full model only; not for nonholonomic models)
+#   SENSITIVITY also emit the full model's sensitivity kernel (derivatives of the linear matrices
+#               by every parameter, for modes/frf --sensitivity); made only when asked (issue 40)
+#   SENSITIVITY_PARAMETERS  the sensitivity kernel by these parameters only (implies SENSITIVITY)
 #
 # Documented in docs/cmake.md.
 include_guard(GLOBAL)
 
 function(mbsgen_add_model target)
-  cmake_parse_arguments(PARSE_ARGV 1 ARG "SOLVER;DYNAMICS" "MODEL;SCENE;OUTPUT_DIR;ID;PARTS" "")
+  cmake_parse_arguments(PARSE_ARGV 1 ARG "SOLVER;DYNAMICS;SENSITIVITY" "MODEL;SCENE;OUTPUT_DIR;ID;PARTS"
+                        "SENSITIVITY_PARAMETERS")
   if(ARG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "mbsgen_add_model(${target}): unknown arguments: ${ARG_UNPARSED_ARGUMENTS}")
   endif()
@@ -69,6 +73,12 @@ function(mbsgen_add_model target)
     set(_dynamics "")
     if(ARG_DYNAMICS)
       set(_dynamics --dynamics)
+    endif()
+    if(ARG_SENSITIVITY_PARAMETERS)
+      list(JOIN ARG_SENSITIVITY_PARAMETERS "," _names)
+      list(APPEND _dynamics --sensitivity-parameters ${_names})
+    elseif(ARG_SENSITIVITY)
+      list(APPEND _dynamics --sensitivity)
     endif()
     add_custom_command(
       OUTPUT ${_stamp}

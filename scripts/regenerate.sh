@@ -12,6 +12,7 @@ fi
 while read -r id model scene flags; do
   [[ -z "$id" || "$id" == \#* ]] && continue
   extra=()
-  [[ "${flags:-}" == dynamics ]] && extra=(--dynamics)
+  IFS=, read -r -a names <<< "${flags:-}"
+  for flag in "${names[@]}"; do extra+=("--$flag"); done  # dynamics, sensitivity
   "$mbsgen" generate "$model" --scene "$scene" --id "$id" --out "generated/$id" "${extra[@]}"
 done < generated/models.txt

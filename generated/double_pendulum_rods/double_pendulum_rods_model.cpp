@@ -24,13 +24,7 @@ const mbsgen::ModelKernels& kernels() {
       double_pendulum_rods_coordinate_names, coordinate_units, double_pendulum_rods_parameter_names, parameter_units, double_pendulum_rods_parameter_defaults,
       double_pendulum_rods_input_names, input_units, double_pendulum_rods_output_names, output_units,
       &double_pendulum_rods_operating_point, &double_pendulum_rods_linear, &double_pendulum_rods_residual, &double_pendulum_rods_mass_matrix,
-      0, false, "0.1.0", nullptr, &double_pendulum_rods_outputs,
-      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr,
-      0, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr, nullptr,
-      nullptr, nullptr,
-      double_pendulum_rods_n_sensitivity_parameters, double_pendulum_rods_sensitivity_parameter_names, &double_pendulum_rods_sensitivity, nullptr};
+      0, false, "0.1.0", nullptr, &double_pendulum_rods_outputs};
   static const mbsgen::ModelKernels k = [] {
     mbsgen::ModelKernels with_checks = base;
     with_checks.n_checks = double_pendulum_rods_n_checks;

@@ -29,8 +29,7 @@ const mbsgen::ModelKernels& kernels() {
       &middle_ear_dynamics, &middle_ear_dynamics_jacobian, nullptr,
       0, 0, nullptr, nullptr,
       nullptr, nullptr, nullptr, nullptr,
-      middle_ear_input_kinds, &middle_ear_excitation,
-      middle_ear_n_sensitivity_parameters, middle_ear_sensitivity_parameter_names, &middle_ear_sensitivity, nullptr};
+      middle_ear_input_kinds, &middle_ear_excitation};
   static const mbsgen::ModelKernels k = [] {
     mbsgen::ModelKernels with_checks = base;
     with_checks.n_checks = middle_ear_n_checks;

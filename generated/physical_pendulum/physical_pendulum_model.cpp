@@ -26,11 +26,7 @@ const mbsgen::ModelKernels& kernels() {
       &physical_pendulum_operating_point, &physical_pendulum_linear, &physical_pendulum_residual, &physical_pendulum_mass_matrix,
       0, false, "0.1.0", nullptr, &physical_pendulum_outputs,
       0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      &physical_pendulum_dynamics, &physical_pendulum_dynamics_jacobian, nullptr,
-      0, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr, nullptr,
-      nullptr, nullptr,
-      physical_pendulum_n_sensitivity_parameters, physical_pendulum_sensitivity_parameter_names, &physical_pendulum_sensitivity, nullptr};
+      &physical_pendulum_dynamics, &physical_pendulum_dynamics_jacobian, nullptr};
   static const mbsgen::ModelKernels k = [] {
     mbsgen::ModelKernels with_checks = base;
     with_checks.n_checks = physical_pendulum_n_checks;

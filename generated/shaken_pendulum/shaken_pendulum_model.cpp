@@ -29,8 +29,7 @@ const mbsgen::ModelKernels& kernels() {
       nullptr, nullptr, nullptr,
       0, 0, nullptr, nullptr,
       nullptr, nullptr, nullptr, nullptr,
-      shaken_pendulum_input_kinds, &shaken_pendulum_excitation,
-      shaken_pendulum_n_sensitivity_parameters, shaken_pendulum_sensitivity_parameter_names, &shaken_pendulum_sensitivity, nullptr};
+      shaken_pendulum_input_kinds, &shaken_pendulum_excitation};
   static const mbsgen::ModelKernels k = [] {
     mbsgen::ModelKernels with_checks = base;
     with_checks.n_checks = shaken_pendulum_n_checks;

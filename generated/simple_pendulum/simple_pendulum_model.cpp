@@ -26,11 +26,7 @@ const mbsgen::ModelKernels& kernels() {
       &simple_pendulum_operating_point, &simple_pendulum_linear, &simple_pendulum_residual, &simple_pendulum_mass_matrix,
       0, false, "0.1.0", nullptr, &simple_pendulum_outputs,
       0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      &simple_pendulum_dynamics, &simple_pendulum_dynamics_jacobian, nullptr,
-      0, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr, nullptr,
-      nullptr, nullptr,
-      simple_pendulum_n_sensitivity_parameters, simple_pendulum_sensitivity_parameter_names, &simple_pendulum_sensitivity, nullptr};
+      &simple_pendulum_dynamics, &simple_pendulum_dynamics_jacobian, nullptr};
   static const mbsgen::ModelKernels k = [] {
     mbsgen::ModelKernels with_checks = base;
     with_checks.n_checks = simple_pendulum_n_checks;

@@ -24,13 +24,7 @@ const mbsgen::ModelKernels& kernels() {
       sleeping_top_coordinate_names, coordinate_units, sleeping_top_parameter_names, parameter_units, sleeping_top_parameter_defaults,
       sleeping_top_input_names, input_units, sleeping_top_output_names, output_units,
       &sleeping_top_operating_point, &sleeping_top_linear, &sleeping_top_residual, &sleeping_top_mass_matrix,
-      0, false, "0.1.0", nullptr, &sleeping_top_outputs,
-      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr,
-      0, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr, nullptr,
-      nullptr, nullptr,
-      sleeping_top_n_sensitivity_parameters, sleeping_top_sensitivity_parameter_names, &sleeping_top_sensitivity, &sleeping_top_operating_point_sensitivity};
+      0, false, "0.1.0", nullptr, &sleeping_top_outputs};
   static const mbsgen::ModelKernels k = [] {
     mbsgen::ModelKernels with_checks = base;
     with_checks.n_checks = sleeping_top_n_checks;

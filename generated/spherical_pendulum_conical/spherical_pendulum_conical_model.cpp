@@ -24,13 +24,7 @@ const mbsgen::ModelKernels& kernels() {
       spherical_pendulum_conical_coordinate_names, coordinate_units, spherical_pendulum_conical_parameter_names, parameter_units, spherical_pendulum_conical_parameter_defaults,
       spherical_pendulum_conical_input_names, input_units, spherical_pendulum_conical_output_names, output_units,
       &spherical_pendulum_conical_operating_point, &spherical_pendulum_conical_linear, &spherical_pendulum_conical_residual, &spherical_pendulum_conical_mass_matrix,
-      0, false, "0.1.0", nullptr, &spherical_pendulum_conical_outputs,
-      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr,
-      0, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr, nullptr,
-      nullptr, nullptr,
-      spherical_pendulum_conical_n_sensitivity_parameters, spherical_pendulum_conical_sensitivity_parameter_names, &spherical_pendulum_conical_sensitivity, &spherical_pendulum_conical_operating_point_sensitivity};
+      0, false, "0.1.0", nullptr, &spherical_pendulum_conical_outputs};
   static const mbsgen::ModelKernels k = [] {
     mbsgen::ModelKernels with_checks = base;
     with_checks.n_checks = spherical_pendulum_conical_n_checks;

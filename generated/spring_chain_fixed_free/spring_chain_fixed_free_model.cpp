@@ -24,13 +24,7 @@ const mbsgen::ModelKernels& kernels() {
       spring_chain_fixed_free_coordinate_names, coordinate_units, spring_chain_fixed_free_parameter_names, parameter_units, spring_chain_fixed_free_parameter_defaults,
       spring_chain_fixed_free_input_names, input_units, spring_chain_fixed_free_output_names, output_units,
       &spring_chain_fixed_free_operating_point, &spring_chain_fixed_free_linear, &spring_chain_fixed_free_residual, &spring_chain_fixed_free_mass_matrix,
-      0, false, "0.1.0", nullptr, &spring_chain_fixed_free_outputs,
-      0, nullptr, nullptr, 0, nullptr, nullptr, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr,
-      0, 0, nullptr, nullptr,
-      nullptr, nullptr, nullptr, nullptr,
-      nullptr, nullptr,
-      spring_chain_fixed_free_n_sensitivity_parameters, spring_chain_fixed_free_sensitivity_parameter_names, &spring_chain_fixed_free_sensitivity, &spring_chain_fixed_free_operating_point_sensitivity};
+      0, false, "0.1.0", nullptr, &spring_chain_fixed_free_outputs};
   static const mbsgen::ModelKernels k = [] {
     mbsgen::ModelKernels with_checks = base;
     with_checks.n_checks = spring_chain_fixed_free_n_checks;

@@ -168,7 +168,8 @@ int main(int argc, char** argv) try {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("mbsgen ") + mbsgen::kGeneratorVersion, "print the version and exit");
   std::string model_file, out_dir, scene = "full", id;
-  bool no_cse = false, dynamics = false;
+  bool no_cse = false, dynamics = false, sensitivity = false;
+  std::vector<std::string> sensitivity_parameters;
   std::size_t parts = 0;
   std::size_t part_operations = 5000;
   auto* check = app.add_subcommand("check", "read and validate a model file (and its operating point)");
@@ -186,6 +187,12 @@ int main(int argc, char** argv) try {
   generate->add_flag("--dynamics", dynamics,
                      "also emit the kernels of a time step (the solver's simulate): dynamics(y, yd, u, p, M, r), "
                      "M and k - q in one kernel sharing their work, and dynamics_jacobian(y, yd, ydd, u, p, Ky, Kv)");
+  generate->add_flag("--sensitivity", sensitivity,
+                     "also emit the sensitivity kernel of the full model: the derivatives of the linear matrices by "
+                     "every parameter (what modes/frf --sensitivity need; a scene asks with its analyses)");
+  generate->add_option("--sensitivity-parameters", sensitivity_parameters,
+                       "the sensitivity kernel by these parameters only (comma-separated; implies --sensitivity)")
+      ->delimiter(',');
   generate->add_option("--parts", parts,
                        "also write ID_part1.cpp … ID_partN.cpp holding the long kernels' parts, to compile in "
                        "parallel (default 0: all in ID.cpp)")
@@ -208,7 +215,8 @@ int main(int argc, char** argv) try {
     auto t0 = std::chrono::steady_clock::now();
     mbsgen::tool::Progress progress(*check ? "check" : *info ? "info" : "generate");
     mbsgen::Model model = mbsgen::read_model_file(model_file);
-    const mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
+    mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
+    if (sensitivity || !sensitivity_parameters.empty()) pruned.request_sensitivity(sensitivity_parameters);
     mbsgen::EmitOptions options;
     options.cse = !no_cse;
     options.dynamics = dynamics;

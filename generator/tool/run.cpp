@@ -32,6 +32,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <system_error>
 #include <thread>
@@ -351,10 +352,12 @@ bool compile_solver(const Toolchain& tc, const fs::path& work, const GeneratedCo
 // an interrupted run leaves a half-built entry. Returns false when the compiler failed. The
 // kernels are split into 2 parts per compiler run at once (EmitOptions::parts), compiled in
 // parallel.
-bool build_solver(const std::string& model_file, const std::string& scene, bool dynamics, const std::string& text,
+bool build_solver(const std::string& model_file, const std::string& scene, bool dynamics,
+                  const std::optional<std::vector<std::string>>& sensitivity, const std::string& text,
                   const Toolchain& tc, const fs::path& dir, Progress& progress) {
   const Model full = read_model_file(model_file);
-  const Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
+  Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
+  if (sensitivity) model.request_sensitivity(*sensitivity);
   const std::size_t parallel = parallel_jobs();
   EmitOptions options;
   options.scene = scene;
@@ -403,6 +406,31 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
   return true;
 }
 
+// `modes|frf --sensitivity [NAME,…]` of the full model: the parameters asked for (empty: all),
+// for a solver with the sensitivity kernel by exactly those (issue 40 §2: made only when asked, and
+// cached as its own entry); nullopt when no sensitivity is asked for, or for a scene (whose
+// analyses say whether it has them).
+std::optional<std::vector<std::string>> sensitivity_request(const std::string& scene, const std::vector<std::string>& args) {
+  if (scene != kFullScene || args.empty() || (args[0] != "modes" && args[0] != "frf")) return std::nullopt;
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a != "--sensitivity" && a.rfind("--sensitivity=", 0) != 0) continue;
+    std::vector<std::string> names;
+    auto add = [&names](const std::string& text) {
+      std::stringstream list(text);
+      for (std::string name; std::getline(list, name, ',');)
+        if (!name.empty()) names.push_back(name);
+    };
+    if (a.size() > 13) add(a.substr(14));
+    else
+      for (std::size_t j = i + 1; j < args.size() && (args[j].empty() || args[j][0] != '-'); ++j) add(args[j]);
+    std::sort(names.begin(), names.end());  // one cache entry per set of parameters
+    names.erase(std::unique(names.begin(), names.end()), names.end());
+    return names;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 #endif  // MBSGEN_RUN_AVAILABLE
 
@@ -419,6 +447,19 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   const bool dynamics = !args.empty() && args[0] == "simulate" && scene == "full";
   std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
   if (dynamics) key += std::string(1, '\0') + "dynamics";
+  const std::optional<std::vector<std::string>> sensitivity = sensitivity_request(scene, args);
+  if (sensitivity && !sensitivity->empty()) {  // an unknown name is a usage error, as the solver's
+    try {
+      read_model_file(model_file).request_sensitivity(*sensitivity);
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "mbsgen run: " << args[0] << " --" << e.what() << "\n";
+      return 2;
+    }
+  }
+  if (sensitivity) {
+    key += std::string(1, '\0') + "sensitivity";
+    for (const auto& name : *sensitivity) key += ',' + name;
+  }
   for (const auto& a : tc.includes) key += '\0' + a;
   // A library or generator rebuilt in place (a developer's build tree) makes a new key: their size
   // and time of modification are part of it, so a solver is never linked against an older runtime
@@ -449,7 +490,7 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
     try {
       TerminationGuard guard;
       Progress progress("run");  // on a terminal, after 2 s: the stage, and files compiled
-      if (!build_solver(model_file, scene, dynamics, text, tc, dir, progress)) return 1;
+      if (!build_solver(model_file, scene, dynamics, sensitivity, text, tc, dir, progress)) return 1;
     } catch (const Terminated& t) {  // the children stopped, the build directory removed
       std::cerr << "mbsgen run: " << t.what() << "; the solver was not built\n";
       return 128 + t.signal;

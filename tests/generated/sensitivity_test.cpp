@@ -26,7 +26,7 @@
 #include "mbsgen/runtime/model/generated_model.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 #include "mbsgen/runtime/spectral/sensitivity.hpp"
-#include "middle_ear_model.hpp"
+#include "middle_ear_sensitivity_model.hpp"
 #include "torqued_pendulum_model.hpp"
 
 namespace {
@@ -157,19 +157,20 @@ TEST(Sensitivity, EquilibriumThatMovesWithTheParameters) {
 
 // Every kernel derivative of the middle ear against central differences of the linear kernel
 // (h = 1e-5 |p|): the truncation, O(h²)·A''', and rounding, O(ε/h)·‖A‖, stay below 1e-7 ‖A‖/|p|
-// for these smooth entries; 87 parameters × M, Q, K, B, C_y, C_v. The derivatives are exact
-// (symbolic); this checks that the emitted code computes the model's.
+// for these smooth entries; 87 parameters × M, Q, K, B, C_y, C_v (middle_ear_sensitivity: the
+// full model generated with --sensitivity). The derivatives are exact (symbolic); this checks that
+// the emitted code computes the model's.
 TEST(Sensitivity, MiddleEarKernelsAgainstCentralDifferences) {
-  GeneratedModel model(middle_ear::kernels());
+  GeneratedModel model(middle_ear_sensitivity::kernels());
   const auto op = model.operating_point();
   const auto d = model.linear_sensitivities(op);
-  ASSERT_EQ(static_cast<int>(d.size()), middle_ear::kernels().n_parameters);
+  ASSERT_EQ(static_cast<int>(d.size()), middle_ear_sensitivity::kernels().n_parameters);
   const auto names = model.parameter_names();
   for (std::size_t j = 0; j < d.size(); ++j) {
     const double p = d[j].value, h = 1e-5 * std::abs(p);
     if (p == 0) continue;  // a zero inertia cannot go negative; the high-precision tests cover such parameters
     auto lin_at = [&](double v) {
-      GeneratedModel q(middle_ear::kernels());
+      GeneratedModel q(middle_ear_sensitivity::kernels());
       q.set(d[j].parameter, v);
       return q.linear_model(q.operating_point());
     };
@@ -197,7 +198,7 @@ TEST(Sensitivity, MiddleEarKernelsAgainstCentralDifferences) {
 // parameter barely moves (relative sensitivities down to 5e-10, whose derivatives carry the
 // rounding of the larger ones: up to 8e-7 relative, 1e-16 in relative units).
 TEST(Sensitivity, MiddleEarEigenvaluesAgainstHighPrecision) {
-  GeneratedModel model(middle_ear::kernels());
+  GeneratedModel model(middle_ear_sensitivity::kernels());
   const auto op = model.operating_point();
   const auto lin = model.linear_model(op);
   const std::vector<std::string> chosen = {"m_malleus", "com_malleus_x", "k_al_z", "d_cochlea_z", "k_eardrum_x"};
@@ -228,7 +229,7 @@ TEST(Sensitivity, MiddleEarEigenvaluesAgainstHighPrecision) {
 // dẑ/dp of the stapes velocity per ear-canal pressure at 0.5, 1 and 4 kHz against 80-digit
 // central differences of the whole response: 1e-9 relative.
 TEST(Sensitivity, MiddleEarResponseAgainstHighPrecision) {
-  GeneratedModel model(middle_ear::kernels());
+  GeneratedModel model(middle_ear_sensitivity::kernels());
   const auto op = model.operating_point();
   const auto lin = model.linear_model(op);
   const auto d = model.linear_sensitivities(op, {"k_al_z", "m_stapes", "d_cochlea_z", "A_tm"});

@@ -602,6 +602,42 @@ TEST(MbsgenCli, DynamicsFlagAddsTheDynamicsKernel) {
   fs::remove_all(dir);
 }
 
+// The full model's sensitivity kernel exists only when asked (issue 40 §2): --sensitivity (every
+// parameter), --sensitivity-parameters (those; an unknown one refused), and `mbsgen run … --
+// modes --sensitivity NAMES`, which builds its own cached solver with the kernel by NAMES:
+// dλ/dk of m ẍ + c ẋ + k x = 0 is −1/(2 m λ + c) = i/(2 ω_d) at λ = −c/2m + i ω_d (m = 1,
+// k = 100, c = 0.5: ω_d = 9.99687 rad/s, dλ/dk = 0.0500156 i), and (k/f_n) df_n/dk = 1/2.
+TEST(MbsgenCli, SensitivityIsMadeWhenAsked) {
+  const fs::path dir = temporary_directory();
+  const std::string model = (kCorpus / "unit_backquote.yaml").string();
+  Result r = run({MBSGEN_TOOL, "generate", model, "--id", "plain", "--out", "a"}, dir);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(slurp(dir / "a" / "plain.hpp").find("_sensitivity("), std::string::npos);
+  r = run({MBSGEN_TOOL, "generate", model, "--id", "all", "--out", "b", "--sensitivity"}, dir);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(slurp(dir / "b" / "all.hpp").find("all_n_sensitivity_parameters = 3"), std::string::npos);
+  r = run({MBSGEN_TOOL, "generate", model, "--id", "some", "--out", "c", "--sensitivity-parameters", "k,m"}, dir);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(slurp(dir / "c" / "some.hpp").find("some_n_sensitivity_parameters = 2"), std::string::npos);
+  EXPECT_NE(slurp(dir / "c" / "some.cpp").find("some_sensitivity_parameter_names[] = {\"m\", \"k\", nullptr}"),
+            std::string::npos);
+  r = run({MBSGEN_TOOL, "generate", model, "--out", "d", "--sensitivity-parameters", "kk"}, dir);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("sensitivity: model 'oscillator' has no parameter 'kk'"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "d"));
+  const std::map<std::string, std::string> env = {{"MBSGEN_CACHE_DIR", (dir / "cache").string()}};
+  r = run({MBSGEN_TOOL, "run", model, "--", "modes", "--sensitivity", "kk"}, dir, env);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("mbsgen run: modes --sensitivity: model 'oscillator' has no parameter 'kk'"),
+            std::string::npos)
+      << r.output;
+  r = run({MBSGEN_TOOL, "run", model, "--", "modes", "--sensitivity", "k", "--format", "csv"}, dir, env);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find(",\"k\",100,-0,0.0500156323"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(",0.5000000000000"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
 // `mbsgen run`: a Bode plot of a model with backquotes in its units runs nothing; a truncated or
 // deleted cached solver is noticed and rebuilt (it used to crash on every run).
 TEST(MbsgenCli, RunRebuildsADamagedCacheEntry) {

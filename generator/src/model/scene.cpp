@@ -16,6 +16,12 @@ std::vector<std::string> SceneSelection::all_kernels() {
           "sensitivity", "physical"};
 }
 
+std::vector<std::string> SceneSelection::full_kernels() {
+  std::vector<std::string> k = all_kernels();
+  k.erase(std::find(k.begin(), k.end(), "sensitivity"));
+  return k;
+}
+
 bool SceneSelection::emits(const std::string& kernel) const {
   return std::find(kernels.begin(), kernels.end(), kernel) != kernels.end();
 }
@@ -421,6 +427,25 @@ void prune_force_outputs(std::vector<Output>& outputs, const Model& pruned) {
 }
 
 }  // namespace
+
+void Model::request_sensitivity(const std::vector<std::string>& parameters) {
+  if (!selection_.full)
+    throw std::invalid_argument("model '" + name_ + "' is pruned for scene '" + selection_.name +
+                                "': a scene has sensitivities when its analyses list 'sensitivity' (with its "
+                                "'sensitivity: [names]'), not on request");
+  std::vector<std::string> known;
+  for (const auto& p : parameters_) known.push_back(p.name);
+  for (const auto& name : parameters)
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      throw std::invalid_argument("sensitivity: model '" + name_ + "' has no parameter '" + name + "'" +
+                                  detail::suggestion(name, known) + " (parameters: " + join(known) + ")");
+  selection_.sensitivity_parameters.clear();
+  for (const auto& p : known)  // in the model's order, once each
+    if (std::find(parameters.begin(), parameters.end(), p) != parameters.end())
+      selection_.sensitivity_parameters.push_back(p);
+  if (!selection_.emits("sensitivity"))
+    selection_.kernels.insert(std::find(selection_.kernels.begin(), selection_.kernels.end(), "physical"), "sensitivity");
+}
 
 Model apply_scene(const Model& model, const std::string& name) {
   const Scene* scene = model.scene(name);

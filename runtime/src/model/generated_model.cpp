@@ -439,8 +439,9 @@ std::vector<MatrixSensitivity> GeneratedModel::linear_sensitivities(const Operat
                                                                     const std::vector<std::string>& names) const {
   if (!k_.sensitivity)
     throw Error("model '" + std::string(k_.model) + "', scene '" + k_.scene +
-                "': no sensitivity kernel (the full model has one unless it has closed loops or rolling constraints; "
-                "a scene needs the analysis 'sensitivity')");
+                "': no sensitivity kernel (it is made when asked: `mbsgen generate --sensitivity`, mbsgen_add_model's "
+                "SENSITIVITY, or a scene with the analysis 'sensitivity'; `mbsgen run … -- modes --sensitivity` builds it "
+                "itself; models with closed loops or rolling constraints have none)");
   const Eigen::Index f = size(), m = k_.n_inputs, r = k_.n_outputs, s = k_.n_sensitivity_parameters;
   if (op.y0.size() != f || op.yd0.size() != f)
     throw DimensionError("GeneratedModel::linear_sensitivities: operating point of size " + std::to_string(op.y0.size()) +

@@ -73,6 +73,34 @@ TEST(SensitivityStage, TheSceneChoosesTheParameters) {
   EXPECT_NE(code.header.find("_sensitivity(const double* y0"), std::string::npos);
 }
 
+// The full model has the sensitivity kernel only when asked (issue 40 §2): by the parameters named,
+// in the model's order, or by all; an unknown name and a pruned scene are refused.
+TEST(SensitivityStage, TheFullModelHasItOnlyWhenAsked) {
+  auto generate = [](const Model& model) {
+    mbsgen::Equations eq = mbsgen::derive(model);
+    const mbsgen::LinearEquations lin = mbsgen::linearize(eq);
+    return mbsgen::emit(model, eq, lin, {});
+  };
+  Model model = read_model_string(kPendulum, "spring_pendulum.yaml");
+  const mbsgen::GeneratedCode plain = generate(model);
+  EXPECT_EQ(plain.header.find("_sensitivity("), std::string::npos);
+  EXPECT_EQ(plain.header.find("HAS_SENSITIVITY"), std::string::npos);
+  model.request_sensitivity({"k", "m"});
+  const mbsgen::GeneratedCode asked = generate(model);
+  EXPECT_NE(asked.header.find("spring_pendulum_n_sensitivity_parameters = 2"), std::string::npos) << asked.header;
+  EXPECT_NE(asked.source.find("sensitivity_parameter_names[] = {\"m\", \"k\""), std::string::npos);
+  model.request_sensitivity({});
+  EXPECT_NE(generate(model).header.find("spring_pendulum_n_sensitivity_parameters = 4"), std::string::npos);
+  try {
+    model.request_sensitivity({"kk"});
+    FAIL() << "an unknown parameter was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("has no parameter 'kk'"), std::string::npos) << e.what();
+  }
+  Model scene = mbsgen::apply_scene(read_model_string(kPendulum, "spring_pendulum.yaml"), "stiffness");
+  EXPECT_THROW(scene.request_sensitivity({}), std::invalid_argument);
+}
+
 // A sensitivity list without the analysis, and an unknown name, are refused at their place.
 TEST(SensitivityStage, RefusedWithTheirPlace) {
   std::string text = kPendulum;

@@ -227,7 +227,8 @@ TEST(Scenes, PrunedModel) {
   const Model full = apply_scene(rotor, "full");
   EXPECT_TRUE(full.selection().full);
   EXPECT_TRUE(full.inertial_velocity_terms());
-  EXPECT_EQ(full.selection().kernels, SceneSelection::all_kernels());
+  EXPECT_EQ(full.selection().kernels, SceneSelection::full_kernels());  // sensitivity only when asked
+  EXPECT_FALSE(full.selection().emits("sensitivity"));
 }
 
 // A scene that asks for simulate emits the kernels of a time step (dynamics and its Jacobian,
