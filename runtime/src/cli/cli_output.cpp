@@ -43,6 +43,13 @@ std::string short_num(double v) {
   return buf;
 }
 
+std::string fixed(double v, const char* format) {
+  if (std::isnan(v)) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
 std::string sweep_problem(double from_hz, double to_hz, long points, bool log_spacing) {
   const std::string range = "--from " + num(from_hz, false) + " --to " + num(to_hz, false);
   if (log_spacing && (from_hz <= 0 || to_hz <= 0))

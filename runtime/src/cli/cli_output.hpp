@@ -23,6 +23,9 @@ namespace mbsgen::cli {
 std::string num(double v, bool json);
 /// %.6e, for tables ("-" for an undefined value, "inf"/"-inf").
 std::string short_num(double v);
+/// v in a printf `format` with one double ("%.6g"); NaN (a statistic of no values: every
+/// evaluation failed, or one value for an sd) is "-", never printed as a number.
+std::string fixed(double v, const char* format);
 /// The largest frequency the command lines take [Hz]: its angular frequency 2π f stays finite
 /// (1e308 Hz gave "frequency 186 is inf rad/s" from the library, exit 1).
 inline constexpr double kMaxFrequencyHz = 1e300;

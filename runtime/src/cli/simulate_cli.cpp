@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 
 #include "cli/bode_plot.hpp"
 #include "cli/cli_files.hpp"
@@ -22,13 +21,6 @@ std::pair<std::string, std::string> assignment(const std::string& text, const ch
   if (eq == std::string::npos || eq == 0)
     throw NameError(std::string(option) + " '" + text + "': expected NAME=VALUE");
   return {text.substr(0, eq), text.substr(eq + 1)};
-}
-
-// %.6g: a number in a message, short.
-std::string g6(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
 }
 
 SimulationOptions simulation_options(const GeneratedModel& model, const SimulateOptions& o) {
@@ -56,7 +48,7 @@ SimulationOptions simulation_options(const GeneratedModel& model, const Simulate
   // seconds sampled every 1e-300 s was a run failure that printed "inf samples".
   const double per_sample = 2.0 * model.size() + model.kernels().n_inputs + model.kernels().n_outputs;
   if (!(s.duration / s.step + 1 <= 5e7 / per_sample))
-    throw NameError("simulate: --duration " + g6(s.duration) + " sampled every " + g6(s.step) +
+    throw NameError("simulate: --duration " + fixed(s.duration, "%.6g") + " sampled every " + fixed(s.step, "%.6g") +
                     " s gives more than " + std::to_string(static_cast<long>(5e7 / per_sample)) + " samples of " +
                     std::to_string(static_cast<long>(per_sample)) +
                     " values (400 MB): sample less often (--step) or simulate less time");

@@ -144,15 +144,6 @@ std::vector<SobolResult> sobol_of(const Study& s) {
 // A table cell: left-aligned in w characters, one space after.
 std::string cell(const std::string& s, std::size_t w) { return s.size() >= w ? s + " " : s + std::string(w - s.size() + 1, ' '); }
 
-// NaN (a statistic of no values: every evaluation failed, or one value for an sd) is "-", never
-// printed as a number; the summary says why below its table.
-std::string fixed(double v, const char* format) {
-  if (std::isnan(v)) return "-";
-  char b[64];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
-
 void write_summary(std::ostream& out, const Study& s, const std::vector<SobolResult>& sobol) {
   const auto& r = s.results;
   const std::size_t ns = r.scalar_names.size();
