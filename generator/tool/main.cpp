@@ -2,6 +2,8 @@
 // Exit codes: 0 success, 1 a bad model or failed analysis, 2 a usage error.
 #include "mbsgen/generator/codegen/emit.hpp"
 #include "mbsgen/generator/codegen/emit_api.hpp"
+#include "mbsgen/generator/codegen/emit_tape.hpp"
+#include "mbsgen/generator/codegen/output_files.hpp"
 #include "mbsgen/generator/linear/operating_point_check.hpp"
 #include "mbsgen/generator/model/scene.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
@@ -13,6 +15,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -114,11 +117,15 @@ int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& sce
 // mbsgen run MODEL [--scene NAME] [-- ARGS...]
 int run_command(int argc, char** argv) {
   const char* usage =
-      "usage: mbsgen run MODEL [--scene NAME] -- info|modes|frf|static|sweep|matrices|simulate|study|outputs [ARGS...]\n"
-      "  generates, compiles and caches the model's solver, then runs it with ARGS\n"
+      "usage: mbsgen run MODEL [--scene NAME] [--compiled] -- info|modes|frf|static|sweep|matrices|simulate|study|outputs "
+      "[ARGS...]\n"
+      "  generates and caches the model's kernels, then runs the solver with ARGS: info, modes, frf, static,\n"
+      "  sweep, matrices and outputs evaluate the kernels from a tape, without a compiler; simulate, study, a\n"
+      "  model with closed loops and --compiled compile and cache the solver first\n"
       "  (the solver's options: mbsgen run MODEL -- --help)\n";
   std::string model_file, scene = "full";
   std::vector<std::string> args;
+  bool compiled = false;
   int i = 2;
   for (; i < argc; ++i) {
     const std::string a = argv[i];
@@ -130,7 +137,9 @@ int run_command(int argc, char** argv) {
       std::cout << usage;
       return 0;
     }
-    if (a == "--scene" && i + 1 < argc) {
+    if (a == "--compiled") {
+      compiled = true;
+    } else if (a == "--scene" && i + 1 < argc) {
       scene = argv[++i];
     } else if (a.rfind("--scene=", 0) == 0) {
       scene = a.substr(8);
@@ -147,7 +156,7 @@ int run_command(int argc, char** argv) {
     return 2;
   }
   try {
-    return mbsgen::tool::run_main(model_file, scene, args);
+    return mbsgen::tool::run_main(model_file, scene, args, compiled);
   } catch (const mbsgen::ModelError& e) {
     std::cerr << e.what() << "\n";
     return 1;
@@ -168,7 +177,7 @@ int main(int argc, char** argv) try {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("mbsgen ") + mbsgen::kGeneratorVersion, "print the version and exit");
   std::string model_file, out_dir, scene = "full", id;
-  bool no_cse = false, dynamics = false, sensitivity = false;
+  bool no_cse = false, dynamics = false, sensitivity = false, tape = false;
   std::vector<std::string> sensitivity_parameters;
   std::size_t parts = 0;
   std::size_t part_operations = 5000;
@@ -193,6 +202,9 @@ int main(int argc, char** argv) try {
   generate->add_option("--sensitivity-parameters", sensitivity_parameters,
                        "the sensitivity kernel by these parameters only (comma-separated; implies --sensitivity)")
       ->delimiter(',');
+  generate->add_flag("--tape", tape,
+                     "also write ID.tape, the kernels as a tape that a program evaluates without a compiler "
+                     "(mbsgen::TapeModel; not for a model with closed loops)");
   generate->add_option("--parts", parts,
                        "also write ID_part1.cpp … ID_partN.cpp holding the long kernels' parts, to compile in "
                        "parallel (default 0: all in ID.cpp)")
@@ -250,12 +262,23 @@ int main(int argc, char** argv) try {
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (*info) return print_info(pruned, model.scenes(), eq, lin, code, seconds);
     const auto& range = pruned.selection().frequency_range;
-    mbsgen::write_generated(code,
-                            mbsgen::emit_api(pruned, lin, code, scene, range ? range->from_hz : 0.0,
-                                             range ? range->to_hz : 0.0, range ? range->points : 0,
-                                             range ? !range->logarithmic : false),
-                            out_dir);
-    std::cerr << "mbsgen: wrote " << out_dir << "/" << code.id << "{.hpp,.cpp,.json,_model.hpp,_model.cpp}"
+    const double from = range ? range->from_hz : 0.0, to = range ? range->to_hz : 0.0;
+    const int points = range ? range->points : 0;
+    const bool linear_spacing = range ? !range->logarithmic : false;
+    std::vector<mbsgen::OutputFile> files = mbsgen::generated_files(code, out_dir);
+    for (auto& f : mbsgen::api_files(mbsgen::emit_api(pruned, lin, code, scene, from, to, points, linear_spacing), out_dir))
+      files.push_back(std::move(f));
+    if (tape) {
+      std::string text = mbsgen::emit_tape(pruned, lin, code, scene, from, to, points, linear_spacing);
+      if (text.empty()) {
+        std::cerr << "mbsgen generate: --tape: model '" << model.name()
+                  << "' has closed loops, whose kernels only compiled code evaluates; nothing was written\n";
+        return 2;
+      }
+      files.push_back({std::filesystem::path(out_dir) / (code.id + ".tape"), std::move(text)});
+    }
+    mbsgen::write_files(files);
+    std::cerr << "mbsgen: wrote " << out_dir << "/" << code.id << (tape ? "{.hpp,.cpp,.json,.tape,_model.hpp,_model.cpp}" : "{.hpp,.cpp,.json,_model.hpp,_model.cpp}")
               << (code.parts.empty() ? "" : " and " + std::to_string(code.parts.size()) + " part files") << " in " << seconds
               << " s\n";
     return 0;

@@ -9,6 +9,7 @@
 
 #include "mbsgen/generator/codegen/emit.hpp"
 #include "mbsgen/generator/codegen/emit_api.hpp"
+#include "mbsgen/generator/codegen/emit_tape.hpp"
 #include "mbsgen/generator/codegen/output_files.hpp"
 #include "mbsgen/generator/linear/operating_point_check.hpp"
 #include "mbsgen/generator/model/scene.hpp"
@@ -38,6 +39,13 @@
 #include <thread>
 
 extern char** environ;
+
+#ifdef MBSGEN_RUN_AVAILABLE
+namespace mbsgen::cli {
+// The solver over a tape file (runtime/cli/solver_cli.hpp; the tool links the solver library).
+int tape_solver_main(const std::string& tape_file, int argc, char** argv);
+}  // namespace mbsgen::cli
+#endif
 
 namespace mbsgen::tool {
 
@@ -252,14 +260,16 @@ std::string solver_record(const fs::path& solver) {
   return line;
 }
 
-// Whether the cache entry dir holds a sound solver; why not otherwise.
-bool sound_entry(const fs::path& dir, std::string& why) {
+// Whether the cache entry dir holds a sound `artifact` (the solver "solve", or the "tape"), with
+// its record `artifact.sum`; why not otherwise.
+bool sound_entry(const fs::path& dir, std::string& why, const std::string& artifact = "solve") {
   std::error_code ec;
   if (!fs::exists(dir, ec)) return false;
+  const fs::path file = dir / artifact, record = dir / (artifact + ".sum");
   try {
-    if (!fs::exists(dir / "solve.sum")) why = "its record solve.sum is missing";
-    else if (!fs::exists(dir / "solve")) why = "the solver is missing";
-    else if (read_file(dir / "solve.sum") != solver_record(dir / "solve")) why = "the solver does not match its record";
+    if (!fs::exists(record)) why = "its record " + record.filename().string() + " is missing";
+    else if (!fs::exists(file)) why = "the " + artifact + " is missing";
+    else if (read_file(record) != solver_record(file)) why = "the " + artifact + " does not match its record";
   } catch (const std::exception& e) {
     why = e.what();
   }
@@ -347,23 +357,25 @@ bool compile_solver(const Toolchain& tc, const fs::path& work, const GeneratedCo
   return false;
 }
 
-// Generates and compiles the solver of model_file into the cache entry dir: in a private
-// directory (mkdtemp) beside it, renamed to dir when complete, so that neither a concurrent nor
-// an interrupted run leaves a half-built entry. Returns false when the compiler failed. The
-// kernels are split into 2 parts per compiler run at once (EmitOptions::parts), compiled in
-// parallel.
-bool build_solver(const std::string& model_file, const std::string& scene, bool dynamics,
-                  const std::optional<std::vector<std::string>>& sensitivity, const std::string& text,
-                  const Toolchain& tc, const fs::path& dir, Progress& progress) {
+// The model of a cache entry derived, linearized, checked and emitted (with id "model").
+struct Emitted {
+  GeneratedCode code;
+  GeneratedApi api;
+  std::string tape;  // empty: closed loops
+  std::string id;    // the model's id (Model's rule: an identifier)
+};
+
+Emitted emit_model(const std::string& model_file, const std::string& scene, bool dynamics,
+                   const std::optional<std::vector<std::string>>& sensitivity, std::size_t parts, Progress& progress) {
   const Model full = read_model_file(model_file);
   Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
   if (sensitivity) model.request_sensitivity(*sensitivity);
-  const std::size_t parallel = parallel_jobs();
   EmitOptions options;
   options.scene = scene;
   options.source_file = model_file;
   options.id = "model";
-  options.parts = 2 * parallel;
+  options.parts = parts;
+  if (parts == 0) options.chunk_operations = 0;  // a tape: nothing is compiled, no kernel is cut
   options.dynamics = dynamics;
   // The kernels that need only the derivation, on the second core while this one linearizes.
   KernelsAhead ahead = progress.paused([&] { return emit_ahead(model, options); });
@@ -376,34 +388,79 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
   progress.stage("checking the operating point");
   check_operating_point(eq, lin);
   progress.stage("emitting the kernels");
-  GeneratedCode code = emit(model, eq, lin, options, &ahead);
+  Emitted e;
+  e.code = emit(model, eq, lin, options, &ahead);
   const auto& range = model.selection().frequency_range;
-  GeneratedApi api = emit_api(model, lin, code, scene, range ? range->from_hz : 0.0, range ? range->to_hz : 0.0,
-                              range ? range->points : 0, range ? !range->logarithmic : false);
+  const double from = range ? range->from_hz : 0.0, to = range ? range->to_hz : 0.0;
+  const int points = range ? range->points : 0;
+  const bool linear_spacing = range ? !range->logarithmic : false;
+  e.api = emit_api(model, lin, e.code, scene, from, to, points, linear_spacing);
+  e.tape = emit_tape(model, lin, e.code, scene, from, to, points, linear_spacing);
+  e.id = full.name();
+  return e;
+}
+
+// A private directory (mkdtemp) beside the cache entry dir, filled by fill and renamed to dir
+// when complete, so that neither a concurrent nor an interrupted run leaves a half-built entry;
+// false when fill returned false (nothing is left behind).
+template <class Fill>
+bool make_entry(const fs::path& dir, Fill&& fill) {
   std::string name = dir.string() + ".tmp-XXXXXX";
   if (!::mkdtemp(name.data()))
     throw std::runtime_error("cannot create a directory beside " + dir.string() + ": " + std::strerror(errno));
   const fs::path work = name;
+  bool made = false;
   try {
-    write_generated(code, api, work.string());
-    write_files({{work / "main.cpp",
-                  "#include \"model_model.hpp\"\n#include \"mbsgen/runtime/cli/solver_cli.hpp\"\n"
-                  "int main(int argc, char** argv) { return mbsgen::cli::solver_main(model::kernels(), argc, argv); }\n"},
-                 {work / "model.yaml", text},  // the model this solver was made from, for reference
-                 // The model's id: the solver's name is `<id>-solve` whatever the file is called,
-                 // as the generated code's (issue 39 §3). An identifier (Model's rule).
-                 {work / "id", full.name()}});
-    if (!compile_solver(tc, work, code, parallel, progress)) return false;
-    write_files({{work / "solve.sum", solver_record(work / "solve")}});  // last: the entry is complete
+    made = fill(work);
   } catch (...) {
     std::error_code ec;
     fs::remove_all(work, ec);
     throw;
   }
   std::error_code ec;
-  fs::rename(work, dir, ec);  // fails if another run won the race: then use its solver
+  if (!made) {
+    fs::remove_all(work, ec);
+    return false;
+  }
+  fs::rename(work, dir, ec);  // fails if another run won the race: then use its entry
   if (ec) fs::remove_all(work, ec);
   return true;
+}
+
+// Generates and compiles the solver of model_file into the cache entry dir (make_entry).
+// Returns false when the compiler failed. The kernels are split into 2 parts per compiler run at
+// once (EmitOptions::parts), compiled in parallel.
+bool build_solver(const std::string& model_file, const std::string& scene, bool dynamics,
+                  const std::optional<std::vector<std::string>>& sensitivity, const std::string& text,
+                  const Toolchain& tc, const fs::path& dir, Progress& progress) {
+  const std::size_t parallel = parallel_jobs();
+  const Emitted e = emit_model(model_file, scene, dynamics, sensitivity, 2 * parallel, progress);
+  return make_entry(dir, [&](const fs::path& work) {
+    write_generated(e.code, e.api, work.string());
+    write_files({{work / "main.cpp",
+                  "#include \"model_model.hpp\"\n#include \"mbsgen/runtime/cli/solver_cli.hpp\"\n"
+                  "int main(int argc, char** argv) { return mbsgen::cli::solver_main(model::kernels(), argc, argv); }\n"},
+                 {work / "model.yaml", text},  // the model this solver was made from, for reference
+                 // The model's id: the solver's name is `<id>-solve` whatever the file is called,
+                 // as the generated code's (issue 39 §3).
+                 {work / "id", e.id}});
+    if (!compile_solver(tc, work, e.code, parallel, progress)) return false;
+    write_files({{work / "solve.sum", solver_record(work / "solve")}});  // last: the entry is complete
+    return true;
+  });
+}
+
+// Generates the tape of model_file into the cache entry dir (make_entry): the file "tape", empty
+// for a model with closed loops (which only a compiled solver evaluates).
+void build_tape(const std::string& model_file, const std::string& scene,
+                const std::optional<std::vector<std::string>>& sensitivity, const std::string& text,
+                const fs::path& dir, Progress& progress) {
+  const Emitted e = emit_model(model_file, scene, false, sensitivity, 0, progress);
+  make_entry(dir, [&](const fs::path& work) {
+    write_files({{work / "tape", e.tape}, {work / "model.yaml", text}, {work / "id", e.id}});
+    write_files({{work / "tape.sum", solver_record(work / "tape")}});  // last: the entry is complete
+    return true;
+  });
 }
 
 // `modes|frf --sensitivity [NAME,…]` of the full model: the parameters asked for (empty: all),
@@ -434,19 +491,89 @@ std::optional<std::vector<std::string>> sensitivity_request(const std::string& s
 }  // namespace
 #endif  // MBSGEN_RUN_AVAILABLE
 
-int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args) {
+#ifdef MBSGEN_RUN_AVAILABLE
+namespace {
+
+// The key's part that names this generator: its file's size and time of modification (a
+// generator rebuilt in place makes new entries).
+std::string exe_identity() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  std::string key = std::string(1, '\0') + self.string();
+  const auto size = fs::file_size(self, ec);
+  const auto time = fs::last_write_time(self, ec);
+  if (!ec) key += '\0' + std::to_string(size) + '\0' + std::to_string(time.time_since_epoch().count());
+  return key;
+}
+
+std::string hex_key(const std::string& key) {
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(key)));
+  return hash;
+}
+
+// The model's id from a cache entry (an entry written before ids were recorded: the file's stem).
+std::string entry_id(const fs::path& dir, const std::string& model_file) {
+  std::string id = fs::path(model_file).stem().string();
+  if (std::error_code ec; fs::is_regular_file(dir / "id", ec)) {
+    const std::string recorded = read_file(dir / "id");
+    if (!recorded.empty() && recorded.size() < 256) id = recorded;
+  }
+  return id;
+}
+
+// Runs args on the model's tape (issue 40 §1: no compiler), generating and caching it first;
+// nullopt when the model has no tape (closed loops): then a compiled solver answers.
+std::optional<int> run_tape(const std::string& model_file, const std::string& scene, std::vector<std::string>& args,
+                            const std::string& text, const std::optional<std::vector<std::string>>& sensitivity) {
+  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + "tape";
+  if (sensitivity) {
+    key += std::string(1, '\0') + "sensitivity";
+    for (const auto& name : *sensitivity) key += ',' + name;
+  }
+  key += exe_identity();
+  const fs::path root = cache_root();
+  ensure_private_directory(root);
+  const fs::path dir = root / hex_key(key);
+  std::string why;
+  if (!sound_entry(dir, why, "tape")) {
+    std::error_code ec;
+    if (!why.empty()) {
+      std::cerr << "mbsgen run: the cached tape " << dir.string() << " is damaged (" << why << "): rebuilding it\n";
+      fs::remove_all(dir, ec);
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    {
+      Progress progress("run");
+      build_tape(model_file, scene, sensitivity, text, dir, progress);
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (::isatty(STDERR_FILENO))
+      std::cerr << "mbsgen run: generated the tape of " << model_file << " in " << std::setprecision(3) << seconds
+                << " s\n";
+    why.clear();
+    if (!sound_entry(dir, why, "tape"))
+      throw std::runtime_error("the tape just made in " + dir.string() + " is not sound (" + why + ")");
+  }
+  std::error_code ec;
+  if (fs::file_size(dir / "tape", ec) == 0 && !ec) return std::nullopt;  // closed loops
+  std::string name = entry_id(dir, model_file) + "-solve";
+  std::vector<char*> argv{name.data()};
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  return mbsgen::cli::tape_solver_main((dir / "tape").string(), static_cast<int>(argv.size() - 1), argv.data());
+}
+
+}  // namespace
+#endif  // MBSGEN_RUN_AVAILABLE
+
+int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args, bool compiled) {
 #ifndef MBSGEN_RUN_AVAILABLE
-  (void)model_file, (void)scene, (void)args;
+  (void)model_file, (void)scene, (void)args, (void)compiled;
   std::cerr << "mbsgen run: this mbsgen was built without the runtime (MBSGEN_BUILD_RUNTIME=OFF)\n";
   return 1;
 #else
   const std::string text = read_model_text(model_file);  // throws: reported by the caller, exit 1
-  const Toolchain tc = toolchain();
-  // `simulate` needs the kernels of a time step (EmitOptions::dynamics: the dynamics Jacobian);
-  // the other commands' solver is built without them, as they cost compile time.
-  const bool dynamics = !args.empty() && args[0] == "simulate" && scene == "full";
-  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
-  if (dynamics) key += std::string(1, '\0') + "dynamics";
   const std::optional<std::vector<std::string>> sensitivity = sensitivity_request(scene, args);
   if (sensitivity && !sensitivity->empty()) {  // an unknown name is a usage error, as the solver's
     try {
@@ -456,6 +583,18 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
       return 2;
     }
   }
+  // The tape answers a one-off analysis; a compiled solver what runs the kernels many times
+  // (simulate, study) and what is asked for with --compiled.
+  const bool many_calls = !args.empty() && (args[0] == "simulate" || args[0] == "study");
+  if (!compiled && !many_calls) {
+    if (const std::optional<int> status = run_tape(model_file, scene, args, text, sensitivity)) return *status;
+  }
+  const Toolchain tc = toolchain();
+  // `simulate` needs the kernels of a time step (EmitOptions::dynamics: the dynamics Jacobian);
+  // the other commands' solver is built without them, as they cost compile time.
+  const bool dynamics = !args.empty() && args[0] == "simulate" && scene == "full";
+  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
+  if (dynamics) key += std::string(1, '\0') + "dynamics";
   if (sensitivity) {
     key += std::string(1, '\0') + "sensitivity";
     for (const auto& name : *sensitivity) key += ',' + name;
@@ -464,21 +603,17 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   // A library or generator rebuilt in place (a developer's build tree) makes a new key: their size
   // and time of modification are part of it, so a solver is never linked against an older runtime
   // nor built from kernels an older generator wrote.
-  std::vector<std::string> artifacts = tc.libraries;
-  artifacts.push_back("/proc/self/exe");
-  for (const auto& a : artifacts) {
+  for (const auto& a : tc.libraries) {
     key += '\0' + a;
     std::error_code ec;
-    const fs::path file = a == "/proc/self/exe" ? fs::read_symlink(a, ec) : fs::path(a);
-    const auto size = fs::file_size(file, ec);
-    const auto time = fs::last_write_time(file, ec);
+    const auto size = fs::file_size(a, ec);
+    const auto time = fs::last_write_time(a, ec);
     if (!ec) key += '\0' + std::to_string(size) + '\0' + std::to_string(time.time_since_epoch().count());
   }
-  char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(key)));
+  key += '\0' + std::string("/proc/self/exe") + exe_identity();
   const fs::path root = cache_root();
   ensure_private_directory(root);
-  const fs::path dir = root / hash;
+  const fs::path dir = root / hex_key(key);
   std::string why;
   if (!sound_entry(dir, why)) {
     std::error_code ec;
@@ -504,16 +639,8 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
       throw std::runtime_error("the solver just built in " + dir.string() + " is not sound (" + why + ")");
   }
   const fs::path solver = dir / "solve";
-  std::vector<char*> argv;
-  // `<id>-solve`, the model's id from the entry (an entry written before ids were recorded: the
-  // file's stem).
-  std::string id = fs::path(model_file).stem().string();
-  if (std::error_code ec; fs::is_regular_file(dir / "id", ec)) {
-    const std::string recorded = read_file(dir / "id");
-    if (!recorded.empty() && recorded.size() < 256) id = recorded;
-  }
-  std::string name = id + "-solve";
-  argv.push_back(name.data());
+  std::string name = entry_id(dir, model_file) + "-solve";
+  std::vector<char*> argv{name.data()};
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   ::execv(solver.c_str(), argv.data());

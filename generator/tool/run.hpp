@@ -6,10 +6,13 @@
 
 namespace mbsgen::tool {
 
-/// Runs the cached solver of model_file (building it first if needed) with args; returns its
-/// exit code (or does not return: the solver replaces this process). Throws ModelError for a
-/// bad model, std::exception for other failures.
-int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args);
+/// Runs args on model_file's cached tape, in this process (issue 40 §1: no compiler), or, for
+/// simulate and study, a model with closed loops, or when `compiled`, on its cached compiled
+/// solver (building either first if needed); returns the exit code (or does not return: the
+/// compiled solver replaces this process). Throws ModelError for a bad model, std::exception for
+/// other failures.
+int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args,
+             bool compiled = false);
 
 /// A T made by make() and never destroyed. The derivation of a large model is millions of GiNaC
 /// nodes, and freeing them one by one took 5 % of a 40-link chain's generation; the process's

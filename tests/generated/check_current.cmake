@@ -17,13 +17,21 @@ foreach(_line IN LISTS _lines)
     endforeach()
   endif()
   file(REMOVE_RECURSE ${OUT}/${_id})
+  # With the tape (read by the test tape_agrees_with_compiled; not committed), except for a model
+  # with closed loops, which has none.
   execute_process(COMMAND ${MBSGEN} generate ${SOURCE_DIR}/${_model} --scene ${_scene} --id ${_id}
-                          --out ${OUT}/${_id} ${_dynamics}
+                          --out ${OUT}/${_id} ${_dynamics} --tape
                   RESULT_VARIABLE _rc ERROR_VARIABLE _err)
+  if(_rc EQUAL 2 AND _err MATCHES "closed loops")
+    execute_process(COMMAND ${MBSGEN} generate ${SOURCE_DIR}/${_model} --scene ${_scene} --id ${_id}
+                            --out ${OUT}/${_id} ${_dynamics}
+                    RESULT_VARIABLE _rc ERROR_VARIABLE _err)
+  endif()
   if(NOT _rc EQUAL 0)
     message(FATAL_ERROR "mbsgen generate ${_model} failed: ${_err}")
   endif()
   file(GLOB _fresh RELATIVE ${OUT}/${_id} ${OUT}/${_id}/*)
+  list(FILTER _fresh EXCLUDE REGEX "[.]tape$")
   foreach(_f IN LISTS _fresh)
     set(_committed ${SOURCE_DIR}/generated/${_id}/${_f})
     if(NOT EXISTS ${_committed})

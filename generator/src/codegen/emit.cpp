@@ -294,6 +294,9 @@ std::vector<std::string> sensitivity_parameter_names(const Model& model) {
 struct EmittedKernel {
   std::string code;
   KernelInfo info;
+  /// The kernel as tape text (emit_tape.hpp): its arguments, statements as printed, and exact
+  /// zeros; empty for a kernel whose outputs come from code (computed_by) or that closes loops.
+  std::string tape;
   /// The kernel's body cut into functions (emit_chunks.hpp): empty definitions when it is short.
   detail::ChunkedBody chunks;
 };
@@ -441,6 +444,31 @@ std::string whole_body(const std::vector<Statement>& statements, std::vector<det
   return body;
 }
 
+// A kernel as tape text (docs/generated-abi.md, "Tapes"): its arguments in the C signature's
+// order, then every statement exactly as printed for the compiler (so that the runtime, parsing
+// it with C++'s precedence and associativity, does the same operations in the same order), the
+// operating point test and the exact zeros there. Empty for a kernel the tape cannot hold.
+std::string tape_kernel(const Kernel& k, const std::vector<detail::PrintedStatement>& printed, std::size_t operations) {
+  if (!k.computed_by.empty() || k.wrapped || k.internal) return "";
+  std::ostringstream t;
+  t << "kernel " << k.name << " " << operations << "\n";
+  for (const auto& a : k.inputs) t << "in " << a.name << " " << a.symbols.size() << "\n";
+  for (const auto& b : k.outputs) t << "out " << b.name << " " << b.values.size() << (b.zero_fill ? " fill" : "") << "\n";
+  for (const auto& p : printed) {
+    std::string line = p.code;
+    std::size_t from = line.find_first_not_of(' ');
+    if (line.compare(from, 13, "const double ") == 0) from += 13;
+    std::size_t to = line.find_last_not_of(";\n");
+    t << "= " << line.substr(from, to + 1 - from) << "\n";
+  }
+  for (std::size_t i = 0; i < k.at_op.arguments.size(); ++i) t << "at " << k.at_op.arguments[i] << " op" << i << "\n";
+  for (const auto& b : k.outputs)
+    for (std::size_t i = 0; i < b.zero_at_op.size(); ++i)
+      if (b.zero_at_op[i]) t << "zero " << b.name << " " << i << "\n";
+  t << "end\n";
+  return t.str();
+}
+
 EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog, bool cse, std::size_t chunk_operations) {
   const std::vector<Statement> statements = kernel_statements(k, prog, cse);
   std::size_t operations = 0;
@@ -488,6 +516,7 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
   code << "  return status;\n}\n\n";
   out.code = code.str();
   out.info = {k.name, sig, operations};
+  out.tape = tape_kernel(k, printed, operations);
   return out;
 }
 
@@ -1337,6 +1366,7 @@ void put(std::string& s, const EmittedKernel& k) {
   put(s, k.chunks.declarations);
   put(s, k.chunks.calls);
   put(s, k.chunks.workspace);
+  put(s, k.tape);
 }
 
 // Reads what put() wrote; ok turns false (and stays) at the first read past the end.
@@ -1371,6 +1401,7 @@ struct Reader {
     k.chunks.declarations = text();
     k.chunks.calls = text();
     k.chunks.workspace = number();
+    k.tape = text();
     return k;
   }
 };
@@ -1552,6 +1583,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
         chunks.push_back({ek.chunks.definitions[c], ek.chunks.operations[c]});
     }
     kernel_code << ek.code;
+    if (!loops) out.tape += ek.tape;  // a model with closed loops has no tape (its kernels close them)
     KernelInfo full_info = ek.info;
     if (k.wrapped) {
       const std::string full = "_" + k.name + "_full(";

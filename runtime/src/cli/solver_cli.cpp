@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <new>
 #include <sstream>
 #include <string>
@@ -27,6 +28,7 @@
 #include "mbsgen/runtime/spectral/descriptor_eigen.hpp"
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/model/matrix_market.hpp"
+#include "mbsgen/runtime/model/tape.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 #include "mbsgen/runtime/version.hpp"
 
@@ -80,6 +82,8 @@ int run_info(const ModelKernels& k, const Options& o, std::ostream& out) {
   for (int i = 0; i < k.n_parameters; ++i)
     out << "  " << pad(k.parameter_names[i], 0) << " = " << num(model.parameters()[static_cast<std::size_t>(i)], false)
         << " " << unit_or(k.parameter_units, i, "") << "\n";
+  out << "kernels: " << (k.evaluation ? std::string(k.evaluation) + " (evaluated without a compiler)" : "compiled")
+      << "\n";
   return 0;
 }
 
@@ -572,6 +576,17 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
 
 int solver_main(const ModelKernels& kernels, int argc, char** argv) {
   return solver_main(kernels, argc, argv, std::cout, std::cerr);
+}
+
+int tape_solver_main(const std::string& tape_file, int argc, char** argv) {
+  std::unique_ptr<TapeModel> tape;
+  try {
+    tape = TapeModel::load(tape_file);
+  } catch (const Error& e) {
+    std::cerr << (argc > 0 ? argv[0] : "mbsgen") << ": " << e.what() << "\n";
+    return 1;
+  }
+  return solver_main(tape->kernels(), argc, argv, std::cout, std::cerr);
 }
 
 }  // namespace mbsgen::cli

@@ -65,6 +65,9 @@ struct GeneratedCode {
   std::string header, source, manifest;
   std::vector<std::string> parts;  ///< `<id>_part<k>.cpp` (EmitOptions::parts)
   std::vector<KernelInfo> kernels;
+  /// The kernels as tape text, one after the other (emit_tape.hpp adds the model's names and
+  /// sizes); empty for a model with closed loops, whose kernels only compiled code evaluates.
+  std::string tape;
 };
 
 class KernelsAhead;

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <iosfwd>
+#include <string>
 
 #include "mbsgen/runtime/model/generated_model.hpp"
 
@@ -26,5 +27,9 @@ int solver_main(const ModelKernels& kernels, int argc, char** argv, std::ostream
 
 /// Same with std::cout and std::cerr.
 int solver_main(const ModelKernels& kernels, int argc, char** argv);
+
+/// The solver of the model in a tape file (model/tape.hpp), evaluated without a compiler: what
+/// `mbsgen run` answers with (issue 40 §1). A tape that cannot be read: a message, 1.
+int tape_solver_main(const std::string& tape_file, int argc, char** argv);
 
 }  // namespace mbsgen::cli

@@ -141,6 +141,9 @@ struct ModelKernels {
   const char* const* check_units = nullptr;
   const char* const* check_parameters = nullptr;
   int (*physical)(const double* p, double* v) = nullptr;
+  /// How the kernels are evaluated (issue 40 §1): null for compiled code, "tape" for a
+  /// TapeModel (model/tape.hpp), which `info` reports. Trailing.
+  const char* evaluation = nullptr;
 };
 
 /// True when input j of the kernels prescribes motion (input_kinds, prescribed motion).
