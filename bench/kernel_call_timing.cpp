@@ -6,9 +6,13 @@
 // other jobs' load changes between them), interleaved CPU time by a few per cent. Prints one
 // line per library and kernel: "<library index> <kernel> <median_s> <checksum>", the checksum a
 // sum of the outputs at a fixed state, so that builds of the same model can be seen to compute
-// the same numbers.
+// the same numbers. A path ending in .tape is a tape (`mbsgen generate --tape`) evaluated by the
+// runtime's TapeModel instead of compiled code (issue 40 §5: the tape's speed per call against
+// the compiled kernels', bench/tape_speed.sh).
 //
-//   kernel_call_timing ID LIBRARY...
+//   kernel_call_timing ID LIBRARY|TAPE...
+#include "mbsgen/runtime/model/tape.hpp"
+
 #include <dlfcn.h>
 #include <time.h>
 
@@ -16,6 +20,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -54,7 +59,28 @@ struct Model {
   std::vector<double> y, yd, u, M, Q, K, B, Cy, Cv, res;
 };
 
+bool buffers(const char* path, const std::string& id, Model& model);
+std::vector<std::unique_ptr<mbsgen::TapeModel>> tapes;  // alive while their kernels are timed
+
 bool load(const char* path, const std::string& id, Model& model) {
+  const std::string file = path;
+  if (file.size() > 5 && file.compare(file.size() - 5, 5, ".tape") == 0) {
+    try {
+      tapes.push_back(mbsgen::TapeModel::load(file));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "kernel_call_timing: %s\n", e.what());
+      return false;
+    }
+    const mbsgen::ModelKernels& k = tapes.back()->kernels();
+    model.p = k.parameter_defaults;
+    model.f = static_cast<std::size_t>(k.n_coordinates);
+    model.m = static_cast<std::size_t>(k.n_inputs);
+    model.r = static_cast<std::size_t>(k.n_outputs);
+    model.mass_matrix = k.mass_matrix;
+    model.residual = k.residual;
+    model.linear = k.linear;
+    return buffers(path, id, model);
+  }
   void* lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
   if (!lib) {
     std::fprintf(stderr, "kernel_call_timing: %s\n", dlerror());
@@ -68,6 +94,10 @@ bool load(const char* path, const std::string& id, Model& model) {
   model.mass_matrix = reinterpret_cast<MassMatrix>(symbol("_mass_matrix"));
   model.residual = reinterpret_cast<Residual>(symbol("_residual"));
   model.linear = reinterpret_cast<Linear>(symbol("_linear"));
+  return buffers(path, id, model);
+}
+
+bool buffers(const char* path, const std::string& id, Model& model) {
   if (!model.p || model.f == 0 || !model.mass_matrix || !model.residual || !model.linear) {
     std::fprintf(stderr, "kernel_call_timing: %s lacks the kernels of %s\n", path, id.c_str());
     return false;

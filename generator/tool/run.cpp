@@ -266,10 +266,11 @@ bool sound_entry(const fs::path& dir, std::string& why, const std::string& artif
   std::error_code ec;
   if (!fs::exists(dir, ec)) return false;
   const fs::path file = dir / artifact, record = dir / (artifact + ".sum");
+  const std::string noun = artifact == "solve" ? "solver" : artifact;
   try {
     if (!fs::exists(record)) why = "its record " + record.filename().string() + " is missing";
-    else if (!fs::exists(file)) why = "the " + artifact + " is missing";
-    else if (read_file(record) != solver_record(file)) why = "the " + artifact + " does not match its record";
+    else if (!fs::exists(file)) why = "the " + noun + " is missing";
+    else if (read_file(record) != solver_record(file)) why = "the " + noun + " does not match its record";
   } catch (const std::exception& e) {
     why = e.what();
   }

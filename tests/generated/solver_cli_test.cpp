@@ -395,6 +395,52 @@ TEST(SolverCli, RunHelpListsEverySolverSubcommand) {
   EXPECT_GE(count, 8);
 }
 
+std::string capture(const std::string& command) {
+  std::string text;
+  FILE* p = ::popen(command.c_str(), "r");
+  if (!p) return text;
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) text.append(buf, n);
+  ::pclose(p);
+  return text;
+}
+
+// `mbsgen run` answers a one-off analysis from the model's tape, without a compiler (issue 40
+// §1), with the same text as the compiled solver's, byte for byte (the numbers are the same bit
+// for bit: tape_agrees_with_compiled), and says so in `info`; --compiled builds the solver.
+TEST(SolverCli, RunAnswersFromATapeAsTheCompiledSolverDoes) {
+  const std::string cache = std::string(MBSGEN_TEST_CACHE) + "/tape";
+  std::filesystem::remove_all(cache);
+  const std::string mbsgen = "MBSGEN_CACHE_DIR='" + cache + "' '" + MBSGEN_TOOL_DIR + "/mbsgen' run ";
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"textbook/double_pendulum", "modes --all --shapes"},
+      {"textbook/double_pendulum", "frf --input F --output tip_x --from 0.1 --to 10 --points 40 --format csv"},
+      {"textbook/double_pendulum", "static --set l1=0.5"},
+      {"textbook/double_pendulum", "sweep --parameter l2 --from 0.5 --to 2 --points 7"},
+      {"middle_ear/middle_ear", "frf --input P --output v_stapes --points 60"},
+      {"rolling/rolling_disk", "modes --set w=1"},
+      {"textbook/base_excited_oscillator", "frf --input xb --output x_rel --points 20"},
+      {"textbook/rotor_disk", "modes"}};
+  for (const auto& [model, command] : runs) {
+    SCOPED_TRACE(model + ": " + command);
+    const std::string id = std::filesystem::path(model).filename().string();
+    const std::string tape = capture(mbsgen + "'" + MBSGEN_SOURCE_DIR + "/models/" + model + ".yaml' -- " + command + " 2>&1");
+    const std::string compiled = capture("'" + std::string(MBSGEN_GENERATED_BIN_DIR) + "/" + id + "-solve' " + command + " 2>&1");
+    EXPECT_GT(tape.size(), 20u) << tape;
+    EXPECT_EQ(tape, compiled);
+  }
+  const std::string model = std::string("'") + MBSGEN_SOURCE_DIR + "/models/textbook/double_pendulum.yaml'";
+  EXPECT_NE(capture(mbsgen + model + " -- info").find("\nkernels: tape (evaluated without a compiler)\n"),
+            std::string::npos);
+  int solvers = 0, tapes = 0;
+  for (const auto& e : std::filesystem::directory_iterator(cache)) {
+    solvers += std::filesystem::exists(e.path() / "solve");
+    tapes += std::filesystem::exists(e.path() / "tape");
+  }
+  EXPECT_EQ(solvers, 0) << "a compiler ran";
+  EXPECT_GE(tapes, 5);
+}
+
 // Every example of docs/cli.md "Model solvers", run in the source directory with the build's
 // solvers and mbsgen on the PATH and a private solver cache.
 TEST(SolverCli, DocumentationExamples) {

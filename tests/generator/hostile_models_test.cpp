@@ -640,36 +640,42 @@ TEST(MbsgenCli, SensitivityIsMadeWhenAsked) {
 
 // `mbsgen run`: a Bode plot of a model with backquotes in its units runs nothing; a truncated or
 // deleted cached solver is noticed and rebuilt (it used to crash on every run).
+// A damaged cache entry is reported and rebuilt: a compiled solver (--compiled) and a tape.
 TEST(MbsgenCli, RunRebuildsADamagedCacheEntry) {
-  const fs::path dir = temporary_directory();
-  const std::map<std::string, std::string> env = {{"MBSGEN_CACHE_DIR", (dir / "cache").string()}};
-  const std::vector<std::string> frf = {MBSGEN_TOOL, "run", (kCorpus / "unit_backquote.yaml").string(), "--",
-                                        "frf", "--input", "F", "--output", "position", "--points", "5",
-                                        "--plot", "bode.png"};
-  Result r = run(frf, dir, env);
-  ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_TRUE(fs::exists(dir / "bode.png"));
-  EXPECT_FALSE(fs::exists(dir / "canary"));
-  std::vector<fs::path> entries;
-  for (const auto& e : fs::directory_iterator(dir / "cache")) entries.push_back(e.path());
-  ASSERT_EQ(entries.size(), 1u);
-  const fs::path solver = entries[0] / "solve";
-  fs::resize_file(solver, 4096);
-  r = run(frf, dir, env);
-  EXPECT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("mbsgen run: the cached solver " + entries[0].string() +
-                          " is damaged (the solver does not match its record): rebuilding it"),
-            std::string::npos)
-      << r.output;
-  fs::remove(solver);
-  r = run(frf, dir, env);
-  EXPECT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("is damaged (the solver is missing): rebuilding it"), std::string::npos) << r.output;
-  r = run(frf, dir, env);  // sound again: no message
-  EXPECT_EQ(r.status, 0);
-  EXPECT_EQ(r.output.find("damaged"), std::string::npos) << r.output;
-  EXPECT_FALSE(fs::exists(dir / "canary"));
-  fs::remove_all(dir);
+  for (const std::string artifact : {"solve", "tape"}) {
+    SCOPED_TRACE(artifact);
+    const std::string noun = artifact == "solve" ? "solver" : "tape";
+    const fs::path dir = temporary_directory();
+    const std::map<std::string, std::string> env = {{"MBSGEN_CACHE_DIR", (dir / "cache").string()}};
+    std::vector<std::string> frf = {MBSGEN_TOOL, "run", (kCorpus / "unit_backquote.yaml").string(), "--",
+                                    "frf", "--input", "F", "--output", "position", "--points", "5",
+                                    "--plot", "bode.png"};
+    if (artifact == "solve") frf.insert(frf.begin() + 3, "--compiled");
+    Result r = run(frf, dir, env);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "bode.png"));
+    EXPECT_FALSE(fs::exists(dir / "canary"));
+    std::vector<fs::path> entries;
+    for (const auto& e : fs::directory_iterator(dir / "cache")) entries.push_back(e.path());
+    ASSERT_EQ(entries.size(), 1u);
+    const fs::path file = entries[0] / artifact;
+    fs::resize_file(file, 4096);
+    r = run(frf, dir, env);
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("mbsgen run: the cached " + noun + " " + entries[0].string() + " is damaged (the " + noun +
+                            " does not match its record): rebuilding it"),
+              std::string::npos)
+        << r.output;
+    fs::remove(file);
+    r = run(frf, dir, env);
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("is damaged (the " + noun + " is missing): rebuilding it"), std::string::npos) << r.output;
+    r = run(frf, dir, env);  // sound again: no message
+    EXPECT_EQ(r.status, 0);
+    EXPECT_EQ(r.output.find("damaged"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "canary"));
+    fs::remove_all(dir);
+  }
 }
 
 // The processes whose command line names `path` (the compilers a build in a cache runs).
@@ -699,7 +705,7 @@ TEST(MbsgenCli, RunStoppedStopsItsCompilers) {
     if (!f || ::dup2(STDOUT_FILENO, STDERR_FILENO) < 0) ::_exit(126);
     ::setenv("MBSGEN_CACHE_DIR", cache.c_str(), 1);
     const std::string model = std::string(MBSGEN_SOURCE_DIR) + "/models/middle_ear/middle_ear.yaml";
-    ::execl(MBSGEN_TOOL, MBSGEN_TOOL, "run", model.c_str(), "--", "modes", static_cast<char*>(nullptr));
+    ::execl(MBSGEN_TOOL, MBSGEN_TOOL, "run", model.c_str(), "--compiled", "--", "modes", static_cast<char*>(nullptr));
     ::_exit(127);
   }
   ASSERT_GT(pid, 0);
