@@ -587,8 +587,9 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   // The tape answers a one-off analysis; a compiled solver what runs the kernels many times
   // (simulate, study) and what is asked for with --compiled.
   const bool many_calls = !args.empty() && (args[0] == "simulate" || args[0] == "study");
+  // The tape's sensitivities come by forward mode (model/tape.hpp): it needs no symbolic kernel.
   if (!compiled && !many_calls) {
-    if (const std::optional<int> status = run_tape(model_file, scene, args, text, sensitivity)) return *status;
+    if (const std::optional<int> status = run_tape(model_file, scene, args, text, std::nullopt)) return *status;
   }
   const Toolchain tc = toolchain();
   // `simulate` needs the kernels of a time step (EmitOptions::dynamics: the dynamics Jacobian);

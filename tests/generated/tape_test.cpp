@@ -17,7 +17,10 @@
 #include <functional>
 #include <memory>
 #include <cstring>
+#include <fstream>
+#include <iostream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -89,9 +92,14 @@ void expect_same_description(const ModelKernels& t, const ModelKernels& c) {
   EXPECT_EQ(t.n_reduced, c.n_reduced);
   EXPECT_EQ(strings(t.reduced_coordinate_names, t.n_reduced), strings(c.reduced_coordinate_names, c.n_reduced));
   EXPECT_EQ(strings(t.reduced_part_names, t.n_reduced_parts), strings(c.reduced_part_names, c.n_reduced_parts));
-  EXPECT_EQ(t.n_sensitivity_parameters, c.n_sensitivity_parameters);
-  EXPECT_EQ(strings(t.sensitivity_parameter_names, t.n_sensitivity_parameters),
-            strings(c.sensitivity_parameter_names, c.n_sensitivity_parameters));
+  if (c.sensitivity || !t.sensitivity) {
+    EXPECT_EQ(t.n_sensitivity_parameters, c.n_sensitivity_parameters);
+    EXPECT_EQ(strings(t.sensitivity_parameter_names, t.n_sensitivity_parameters),
+              strings(c.sensitivity_parameter_names, c.n_sensitivity_parameters));
+  } else {  // without the symbolic kernel, the tape's by forward mode: by every parameter
+    EXPECT_EQ(strings(t.sensitivity_parameter_names, t.n_sensitivity_parameters),
+              strings(c.parameter_names, c.n_parameters));
+  }
   EXPECT_EQ(t.n_checks, c.n_checks);
   EXPECT_EQ(strings(t.check_kinds, t.n_checks), strings(c.check_kinds, c.n_checks));
   EXPECT_EQ(strings(t.check_labels, t.n_checks), strings(c.check_labels, c.n_checks));
@@ -114,7 +122,12 @@ void expect_same_kernels(const ModelKernels& t, const ModelKernels& c) {
       {"excitation", {!!t.excitation, !!c.excitation}}, {"sensitivity", {!!t.sensitivity, !!c.sensitivity}},
       {"operating_point_sensitivity", {!!t.operating_point_sensitivity, !!c.operating_point_sensitivity}},
       {"physical", {!!t.physical, !!c.physical}}};
-  for (const auto& [name, has] : present) EXPECT_EQ(has.first, has.second) << "kernel " << name;
+  const bool forward_mode = !c.sensitivity && t.sensitivity;  // (ForwardSensitivities… below)
+  for (const auto& [name, has] : present) {
+    if (!forward_mode || std::string(name).find("sensitivity") == std::string::npos) {
+      EXPECT_EQ(has.first, has.second) << "kernel " << name;
+    }
+  }
 }
 
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b, std::string& where) {
@@ -194,6 +207,74 @@ TEST(TapeModel, AgreesWithTheCompiledKernelsOfEveryShippedModel) {
     }
   }
   EXPECT_GT(compared, 100u);
+}
+
+// The tape's sensitivities by forward mode (issue 40 §2) against the symbolic sensitivity kernel,
+// on every shipped model that has one: the tapes with their symbolic kernels taken out, so that
+// forward mode answers, through GeneratedModel::linear_sensitivities as `modes --sensitivity`
+// uses it (the operating point's derivatives included). Two ways of differentiating, each in
+// double precision: they agree to the rounding of the chains of operations that compute them,
+// bounded here as 1e-13 of the largest entry of the two blocks (500 units in the last place;
+// measured on 2026-11-29: 2.4e-16 at most over the 10 models and every parameter).
+std::string without_kernel(std::string text, const std::string& name) {
+  const std::size_t from = text.find("\nkernel " + name + " ");
+  if (from == std::string::npos) return text;
+  const std::size_t to = text.find("\nend\n", from);
+  return text.erase(from, to + 4 - from);
+}
+
+double largest_difference = 0;  // relative to the block's largest entry, over every comparison
+
+void expect_close(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const std::string& what) {
+  ASSERT_EQ(a.rows(), b.rows()) << what;
+  ASSERT_EQ(a.cols(), b.cols()) << what;
+  if (a.size() == 0) return;
+  const double scale = std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff());
+  if (scale > 0) largest_difference = std::max(largest_difference, (a - b).cwiseAbs().maxCoeff() / scale);
+  EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-13 * scale) << what << ": forward mode\n" << a << "\nsymbolic\n" << b;
+}
+
+TEST(TapeModel, ForwardSensitivitiesAgreeWithTheSymbolicKernel) {
+  int models = 0;
+  for (const auto& [id, kernels] : tape_models()) {
+    const ModelKernels& c = kernels();
+    if (!c.sensitivity || c.assemble) continue;
+    SCOPED_TRACE(id);
+    std::ifstream in(std::string(MBSGEN_FRESH_DIR) + "/" + id + "/" + id + ".tape");
+    std::stringstream text;
+    text << in.rdbuf();
+    const auto tape = mbsgen::TapeModel::parse(
+        without_kernel(without_kernel(text.str(), "sensitivity"), "operating_point_sensitivity"), id);
+    const ModelKernels& t = tape->kernels();
+    ASSERT_NE(t.sensitivity, nullptr);
+    EXPECT_EQ(t.n_sensitivity_parameters, t.n_parameters);  // forward mode: by every parameter
+    mbsgen::GeneratedModel by_tape(t), by_kernel(c);
+    const mbsgen::OperatingPoint op = by_kernel.operating_point();
+    const std::vector<std::string> names = strings(c.sensitivity_parameter_names, c.n_sensitivity_parameters);
+    const auto a = by_tape.linear_sensitivities(by_tape.operating_point(), names);
+    const auto b = by_kernel.linear_sensitivities(op, names);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t j = 0; j < a.size(); ++j) {
+      const std::string what = "d/d" + a[j].parameter;
+      expect_close(a[j].M, b[j].M, what + " M");
+      expect_close(a[j].Q, b[j].Q, what + " Q");
+      expect_close(a[j].K, b[j].K, what + " K");
+      expect_close(a[j].B, b[j].B, what + " B");
+      expect_close(a[j].C_y, b[j].C_y, what + " C_y");
+      expect_close(a[j].C_v, b[j].C_v, what + " C_v");
+      expect_close(a[j].C_a, b[j].C_a, what + " C_a");
+      expect_close(a[j].D, b[j].D, what + " D");
+      expect_close(a[j].B1, b[j].B1, what + " B1");
+      expect_close(a[j].B2, b[j].B2, what + " B2");
+      expect_close(a[j].D1, b[j].D1, what + " D1");
+      expect_close(a[j].dy0, b[j].dy0, what + " y0");
+      expect_close(a[j].dyd0, b[j].dyd0, what + " yd0");
+    }
+    ++models;
+  }
+  EXPECT_GE(models, 8);
+  std::cout << "forward mode against the symbolic kernels of " << models << " models: largest difference "
+            << largest_difference << " of the block's largest entry\n";
 }
 
 }  // namespace

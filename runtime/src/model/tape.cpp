@@ -67,21 +67,101 @@ struct TapeKernel {
   mutable std::vector<std::unique_ptr<double[]>> spare;
 
   int run(void* const* argv) const;
+  /// Forward mode (issue 40 §2): the derivatives of the outputs along s directions. inputs: the
+  /// inputs' values; seeds[i]: the directions of input i, s blocks of its length one after the
+  /// other (null: zero); tangents[o]: the same for output o (null: not wanted). Exact zeros at
+  /// the operating point have zero derivatives (they are zero there for every parameter value).
+  /// Returns 1 when a value or derivative is not finite.
+  int derivatives(const double* const* inputs, const double* const* seeds, std::size_t s,
+                  double* const* tangents) const;
+
+ private:
+  std::unique_ptr<double[]> workspace() const;
+  void give_back(std::unique_ptr<double[]> w) const;
+  bool at_operating_point(const double* v) const;
 };
 
-int TapeKernel::run(void* const* argv) const {
-  std::unique_ptr<double[]> w;
+// One instruction's value and derivatives, d ← op(a, b): the value from va, vb, the derivatives
+// along s directions from ta, tb (tb unused by unary ops; td may alias ta or tb, element by
+// element).
+inline double tangent_step(std::uint32_t op, double va, double vb, const double* ta, const double* tb, double* td,
+                           std::size_t s) {
+  double vd = 0, da = 0, db = 0;  // vd = op(va, vb); td = da ta + db tb
+  switch (op) {
+    case kMov: vd = va, da = 1; break;
+    case kNeg: vd = -va, da = -1; break;
+    case kAdd: vd = va + vb, da = 1, db = 1; break;
+    case kSub: vd = va - vb, da = 1, db = -1; break;
+    case kMul: vd = va * vb, da = vb, db = va; break;
+    case kDiv: vd = va / vb, da = 1 / vb, db = -vd / vb; break;
+    case kSqrt: vd = std::sqrt(va), da = 0.5 / vd; break;
+    case kSin: vd = std::sin(va), da = std::cos(va); break;
+    case kCos: vd = std::cos(va), da = -std::sin(va); break;
+    case kTan: vd = std::tan(va), da = 1 + vd * vd; break;
+    case kExp: vd = std::exp(va), da = vd; break;
+    case kLog: vd = std::log(va), da = 1 / va; break;
+    case kFabs: vd = std::fabs(va), da = va > 0 ? 1 : va < 0 ? -1 : 0; break;
+    case kAsin: vd = std::asin(va), da = 1 / std::sqrt(1 - va * va); break;
+    case kAcos: vd = std::acos(va), da = -1 / std::sqrt(1 - va * va); break;
+    case kAtan: vd = std::atan(va), da = 1 / (1 + va * va); break;
+    case kSinh: vd = std::sinh(va), da = std::cosh(va); break;
+    case kCosh: vd = std::cosh(va), da = std::sinh(va); break;
+    case kTanh: vd = std::tanh(va), da = 1 - vd * vd; break;
+    case kAsinh: vd = std::asinh(va), da = 1 / std::sqrt(va * va + 1); break;
+    case kAcosh: vd = std::acosh(va), da = 1 / std::sqrt(va * va - 1); break;
+    case kAtanh: vd = std::atanh(va), da = 1 / (1 - va * va); break;
+    case kAtan2: {
+      vd = std::atan2(va, vb);
+      const double r2 = va * va + vb * vb;
+      da = vb / r2, db = -va / r2;
+      break;
+    }
+    case kPow:
+      vd = std::pow(va, vb);
+      da = vb * std::pow(va, vb - 1);
+      db = va > 0 ? vd * std::log(va) : 0;  // (the generator's exponents are numbers: tb is 0)
+      break;
+  }
+  if (db == 0) {
+    for (std::size_t k = 0; k < s; ++k) td[k] = da * ta[k];
+  } else {
+    for (std::size_t k = 0; k < s; ++k) td[k] = da * ta[k] + db * tb[k];
+  }
+  return vd;
+}
+
+std::unique_ptr<double[]> TapeKernel::workspace() const {
   {
     std::lock_guard<std::mutex> lock(mutex);
     if (!spare.empty()) {
-      w = std::move(spare.back());
+      std::unique_ptr<double[]> w = std::move(spare.back());
       spare.pop_back();
+      return w;
     }
   }
-  if (!w) {
-    w.reset(new double[initial.size()]);
-    std::copy(initial.begin(), initial.end(), w.get());
+  std::unique_ptr<double[]> w(new double[initial.size()]);
+  std::copy(initial.begin(), initial.end(), w.get());
+  return w;
+}
+
+void TapeKernel::give_back(std::unique_ptr<double[]> w) const {
+  std::lock_guard<std::mutex> lock(mutex);
+  spare.push_back(std::move(w));
+}
+
+// The compiled kernel's test (emit.cpp): every argument within 8 units in the last place of the
+// operating point's value.
+bool TapeKernel::at_operating_point(const double* v) const {
+  bool at = !at_op.empty();
+  for (const auto& [a, op] : at_op) {
+    const double x = v[a], value = v[op];
+    at = at && (x == value || std::fabs(x - value) <= 8 * 2.220446049250313e-16 * std::fabs(value));
   }
+  return at;
+}
+
+int TapeKernel::run(void* const* argv) const {
+  std::unique_ptr<double[]> w = workspace();
   double* const v = w.get();
   for (std::size_t i = 0; i < info.inputs.size(); ++i)
     if (info.inputs[i].second)
@@ -120,14 +200,7 @@ int TapeKernel::run(void* const* argv) const {
     if (fill[o] && info.outputs[o].second)
       std::memset(argv[ni + o], 0, sizeof(double) * info.outputs[o].second);
   for (const auto& [o, i, slot] : copies) static_cast<double*>(argv[ni + o])[i] = v[slot];
-  // The compiled kernel's test (emit.cpp): every argument within 8 units in the last place of
-  // the operating point's value.
-  bool at = !at_op.empty();
-  for (const auto& [a, op] : at_op) {
-    const double x = v[a], value = v[op];
-    at = at && (x == value || std::fabs(x - value) <= 8 * 2.220446049250313e-16 * std::fabs(value));
-  }
-  if (at)
+  if (at_operating_point(v))
     for (const auto& [o, i] : zeros) static_cast<double*>(argv[ni + o])[i] = 0.0;
   int status = 0;
   for (std::size_t o = 0; o < info.outputs.size(); ++o) {
@@ -135,8 +208,45 @@ int TapeKernel::run(void* const* argv) const {
     for (std::size_t i = 0; i < info.outputs[o].second; ++i)
       if (!std::isfinite(b[i])) status = 1;
   }
-  std::lock_guard<std::mutex> lock(mutex);
-  spare.push_back(std::move(w));
+  give_back(std::move(w));
+  return status;
+}
+
+int TapeKernel::derivatives(const double* const* inputs, const double* const* seeds, std::size_t s,
+                            double* const* tangents) const {
+  constexpr std::size_t kBatch = 8;  // directions per pass: the derivatives of every slot fit in cache
+  const std::size_t n = initial.size();
+  std::vector<double> v(initial), t(n * kBatch);
+  int status = 0;
+  for (std::size_t k0 = 0; k0 < s; k0 += kBatch) {
+    const std::size_t b = std::min(kBatch, s - k0);
+    std::fill(t.begin(), t.end(), 0.0);
+    for (std::size_t i = 0; i < info.inputs.size(); ++i)
+      for (std::size_t e = 0; e < info.inputs[i].second; ++e) {
+        v[input_offset[i] + e] = inputs[i][e];
+        if (seeds[i])
+          for (std::size_t k = 0; k < b; ++k)
+            t[(input_offset[i] + e) * kBatch + k] = seeds[i][(k0 + k) * info.inputs[i].second + e];
+      }
+    for (const Instruction& c : code)
+      v[c.dst] = tangent_step(c.op, v[c.a], v[c.b], &t[c.a * kBatch], &t[c.b * kBatch], &t[c.dst * kBatch], b);
+    const bool at = at_operating_point(v.data());
+    for (std::size_t o = 0; o < info.outputs.size(); ++o) {
+      double* const out = tangents[o];
+      const std::size_t len = info.outputs[o].second;
+      if (!out) continue;
+      for (std::size_t k = 0; k < b; ++k) std::fill(out + (k0 + k) * len, out + (k0 + k + 1) * len, 0.0);
+      for (const auto& [oo, i, slot] : copies)
+        if (oo == o)
+          for (std::size_t k = 0; k < b; ++k) out[(k0 + k) * len + i] = t[slot * kBatch + k];
+      if (at)
+        for (const auto& [oo, i] : zeros)
+          if (oo == o)
+            for (std::size_t k = 0; k < b; ++k) out[(k0 + k) * len + i] = 0.0;
+      for (std::size_t e = k0 * len; e < (k0 + b) * len; ++e)
+        if (!std::isfinite(out[e])) status = 1;
+    }
+  }
   return status;
 }
 
@@ -157,7 +267,53 @@ struct TapeModel::Impl {
   std::vector<std::vector<const char*>> arrays;
   ModelKernels k{};
   int slot = -1;
+  /// The sensitivity kernels by forward mode over linear, output_terms, excitation, operating_point
+  /// and residual, by every parameter (a tape without the symbolic ones; issue 40 §2).
+  bool forward_sensitivity = false;
+  int sensitivity_by_forward_mode(void* const* argv) const;
+  int operating_point_sensitivity_by_forward_mode(void* const* argv) const;
 };
+
+// sensitivity(y0, yd0, p, dy0, dyd0, dM, dQ, dK, dB, dCy, dCv, dCa, dD, dB1, dB2, dD1): the total
+// derivatives by each parameter p_j of the linear matrices, along (dy0_j, dyd0_j, e_j).
+int TapeModel::Impl::sensitivity_by_forward_mode(void* const* argv) const {
+  const std::size_t s = parameters.size();
+  std::vector<double> identity(s * s, 0.0);
+  for (std::size_t j = 0; j < s; ++j) identity[j * s + j] = 1;
+  auto in = [&](std::size_t i) { return static_cast<const double*>(argv[i]); };
+  auto out = [&](std::size_t i) { return static_cast<double*>(argv[i]); };
+  int status = 0;
+  auto along = [&](const TapeKernel* kernel, std::vector<double*> derivatives) {
+    const double* values[] = {in(0), in(1), in(2)};
+    const double* seeds[] = {in(3), kernel->info.inputs[1].second ? in(4) : nullptr, identity.data()};
+    status = std::max(status, kernel->derivatives(values, seeds, s, derivatives.data()));
+  };
+  along(known[kLinear], {out(5), out(6), out(7), out(8), out(9), out(10)});
+  if (known[kOutputTerms]) along(known[kOutputTerms], {out(11), out(12)});
+  if (known[kExcitation]) along(known[kExcitation], {out(13), out(14), out(15)});
+  return status;
+}
+
+// operating_point_sensitivity(y0, yd0, p, dy0 | dr, dyd0): a given point's derivatives by the
+// parameters; for a static equilibrium dr = ∂r/∂p + Q dyd0 (the caller solves K dy0 = −dr).
+int TapeModel::Impl::operating_point_sensitivity_by_forward_mode(void* const* argv) const {
+  const std::size_t s = parameters.size();
+  std::vector<double> identity(s * s, 0.0);
+  for (std::size_t j = 0; j < s; ++j) identity[j * s + j] = 1;
+  const double* p = static_cast<const double*>(argv[2]);
+  double* first = static_cast<double*>(argv[3]);
+  double* dyd0 = static_cast<double*>(argv[4]);
+  const double* values[] = {p};
+  const double* seeds[] = {identity.data()};
+  double* tangents[] = {equilibrium ? nullptr : first, dyd0};
+  int status = known[kOperatingPoint]->derivatives(values, seeds, s, tangents);
+  if (!equilibrium) return status;
+  const std::vector<double> u(inputs.size() + 1, 0.0);
+  const double* r_values[] = {static_cast<const double*>(argv[0]), static_cast<const double*>(argv[1]), u.data(), p};
+  const double* r_seeds[] = {nullptr, dyd0, nullptr, identity.data()};
+  double* r_tangents[] = {first};
+  return std::max(status, known[kResidual]->derivatives(r_values, r_seeds, s, r_tangents));
+}
 
 namespace {
 
@@ -170,8 +326,19 @@ int call(A... a) {
   return g_slots[S].load(std::memory_order_acquire)->known[K]->run(argv);
 }
 
+template <int S, int K, class... A>
+int by_forward_mode(A... a) {
+  void* argv[] = {const_cast<void*>(static_cast<const void*>(a))...};
+  const TapeModel::Impl* t = g_slots[S].load(std::memory_order_acquire);
+  return K == kSensitivity ? t->sensitivity_by_forward_mode(argv) : t->operating_point_sensitivity_by_forward_mode(argv);
+}
+
 template <int S>
 void bind(ModelKernels& m, const TapeModel::Impl& t) {
+  if (t.forward_sensitivity) {
+    m.sensitivity = &by_forward_mode<S, kSensitivity>;
+    m.operating_point_sensitivity = &by_forward_mode<S, kOperatingPointSensitivity>;
+  }
   const auto& k = t.known;
   if (k[kOperatingPoint]) m.operating_point = &call<S, kOperatingPoint>;
   if (k[kLinear]) m.linear = &call<S, kLinear>;
@@ -781,6 +948,11 @@ void fill_kernels(TapeModel::Impl& t) {
   if (t.known[kSensitivity]) {
     k.n_sensitivity_parameters = static_cast<int>(t.sensitivity.size());
     k.sensitivity_parameter_names = c_strings(t, t.sensitivity);
+  } else if (t.known[kLinear] && t.known[kOperatingPoint] && (!t.equilibrium || t.known[kResidual]) &&
+             !t.known[kOperatingPointSensitivity]) {
+    t.forward_sensitivity = true;  // by every parameter, from the tape (bind)
+    k.n_sensitivity_parameters = static_cast<int>(t.parameters.size());
+    k.sensitivity_parameter_names = c_strings(t, t.parameters);
   }
   if (t.known[kPhysical]) {
     k.n_checks = static_cast<int>(t.check_kinds.size());
