@@ -515,7 +515,8 @@ EmittedKernel emit_kernel(const std::string& id, const Kernel& k, Program& prog,
       code << "  if (!all_finite(" << b.name << ", " << b.values.size() << ")) status = 1;\n";
   code << "  return status;\n}\n\n";
   out.code = code.str();
-  out.info = {k.name, sig, operations};
+  out.info = {k.name, sig, operations, out.code.size()};
+  for (const auto& d : out.chunks.definitions) out.info.bytes += d.size();
   out.tape = tape_kernel(k, printed, operations);
   return out;
 }
@@ -974,7 +975,7 @@ std::string manifest_json(const Model& model, const Equations& eq, const LinearE
     << ",\n  \"kernels\": [";
   for (std::size_t i = 0; i < out.kernels.size(); ++i)
     j << (i ? "," : "") << "\n    {\"name\": " << json_string(out.kernels[i].name)
-      << ", \"operations\": " << out.kernels[i].operations
+      << ", \"operations\": " << out.kernels[i].operations << ", \"bytes\": " << out.kernels[i].bytes
       << ", \"signature\": " << json_string(out.kernels[i].signature) << "}";
   j << "\n  ]\n}\n";
   return j.str();
@@ -1360,6 +1361,7 @@ void put(std::string& s, const EmittedKernel& k) {
   put(s, k.info.name);
   put(s, k.info.signature);
   put(s, k.info.operations);
+  put(s, k.info.bytes);
   put(s, k.chunks.definitions.size());
   for (const auto& d : k.chunks.definitions) put(s, d);
   for (std::size_t n : k.chunks.operations) put(s, n);
@@ -1395,6 +1397,7 @@ struct Reader {
     k.info.name = text();
     k.info.signature = text();
     k.info.operations = number();
+    k.info.bytes = number();
     const std::size_t chunks = number();
     for (std::size_t c = 0; ok && c < chunks; ++c) k.chunks.definitions.push_back(text());
     for (std::size_t c = 0; ok && c < chunks; ++c) k.chunks.operations.push_back(number());

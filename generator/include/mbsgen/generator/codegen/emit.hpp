@@ -58,6 +58,7 @@ struct KernelInfo {
   std::string name;
   std::string signature;
   std::size_t operations = 0;  ///< +, −, ×, ÷ and function calls in the emitted code
+  std::size_t bytes = 0;       ///< its C++ (with its parts), as written
 };
 
 struct GeneratedCode {
