@@ -23,7 +23,7 @@ timed() {  # cache, then the run's arguments: prints "seconds peak_MB"
   local cache=$1
   shift
   MBSGEN_CACHE_DIR=$cache /usr/bin/time -f '%e %M' -o "$work/time" "$mbsgen" run "$@" >/dev/null 2>&1 || echo "failed: $*" >&2
-  awk '{ printf "%.2f %.0f", $1, $2 / 1024 }' "$work/time"
+  awk '{ printf "%.2f %.0f\n", $1, $2 / 1024 }' "$work/time"
 }
 printf '%-48s %10s %8s %10s %12s %8s %10s\n' model tape_s tape_MB warm_s compiled_s comp_MB warm_s
 for model in "${models[@]}"; do

@@ -456,7 +456,14 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
 void build_tape(const std::string& model_file, const std::string& scene,
                 const std::optional<std::vector<std::string>>& sensitivity, const std::string& text,
                 const fs::path& dir, Progress& progress) {
-  const Emitted e = emit_model(model_file, scene, false, sensitivity, 0, progress);
+  // A joint or distance constraint closes a loop: known without deriving (rolling contacts may or
+  // may not leave a holonomic condition, which only the derivation tells).
+  const Model model = apply_scene(read_model_file(model_file), scene);
+  const bool loops = std::any_of(model.constraints().begin(), model.constraints().end(),
+                                 [](const Constraint& c) { return c.kind != ConstraintKind::rolling; });
+  Emitted e;
+  if (loops) e.id = model.name();
+  else e = emit_model(model_file, scene, false, sensitivity, 0, progress);
   make_entry(dir, [&](const fs::path& work) {
     write_files({{work / "tape", e.tape}, {work / "model.yaml", text}, {work / "id", e.id}});
     write_files({{work / "tape.sum", solver_record(work / "tape")}});  // last: the entry is complete
