@@ -366,11 +366,41 @@ struct Emitted {
   std::string id;    // the model's id (Model's rule: an identifier)
 };
 
+// A model derived and linearized for a cache entry. The last one is kept: a run that derives a
+// model for its tape and finds closed loops (which only compiled code evaluates) emits its
+// solver from the same derivation.
+struct Derivation {
+  std::string key;
+  Model model;  // the scene's, with the sensitivity asked for
+  Equations* eq;
+  LinearEquations* lin;
+};
+
+// The derivation of model_file's scene; `ahead` starts the kernels that need only the derivation
+// on the second core (for options) when it derives.
+Derivation& derivation(const std::string& model_file, const std::string& scene,
+                       const std::optional<std::vector<std::string>>& sensitivity, const EmitOptions& options,
+                       KernelsAhead& ahead, Progress& progress) {
+  static auto* last = new std::optional<Derivation>;  // (never destroyed: see kept_until_exit)
+  std::string key = model_file + '\0' + scene + '\0' + (sensitivity ? "s" : "-");
+  if (sensitivity)
+    for (const auto& name : *sensitivity) key += ',' + name;
+  if (*last && (*last)->key == key) return **last;
+  Model model = apply_scene(read_model_file(model_file), scene);  // ModelError for a scene the file lacks
+  if (sensitivity) model.request_sensitivity(*sensitivity);
+  ahead = progress.paused([&] { return emit_ahead(model, options); });
+  progress.stage("deriving the equations");
+  Equations& eq = kept_until_exit<Equations>([&] { return derive(model); });
+  progress.stage("linearizing");
+  LinearEquations& lin = kept_until_exit<LinearEquations>([&] { return linearize(eq); });
+  progress.stage("checking the operating point");
+  check_operating_point(eq, lin);
+  *last = Derivation{key, std::move(model), &eq, &lin};
+  return **last;
+}
+
 Emitted emit_model(const std::string& model_file, const std::string& scene, bool dynamics,
                    const std::optional<std::vector<std::string>>& sensitivity, std::size_t parts, Progress& progress) {
-  const Model full = read_model_file(model_file);
-  Model model = apply_scene(full, scene);  // ModelError for a scene the file lacks
-  if (sensitivity) model.request_sensitivity(*sensitivity);
   EmitOptions options;
   options.scene = scene;
   options.source_file = model_file;
@@ -378,26 +408,20 @@ Emitted emit_model(const std::string& model_file, const std::string& scene, bool
   options.parts = parts;
   if (parts == 0) options.chunk_operations = 0;  // a tape: nothing is compiled, no kernel is cut
   options.dynamics = dynamics;
-  // The kernels that need only the derivation, on the second core while this one linearizes.
-  KernelsAhead ahead = progress.paused([&] { return emit_ahead(model, options); });
-  progress.stage("deriving the equations");
-  Equations& eq = kept_until_exit<Equations>([&] { return derive(model); });
+  KernelsAhead ahead;
+  Derivation& d = derivation(model_file, scene, sensitivity, options, ahead, progress);
   // A model with rolling constraints has no second-order form: its solver refuses `simulate`.
-  if (eq.nonholonomic.active) options.dynamics = false;
-  progress.stage("linearizing");
-  LinearEquations& lin = kept_until_exit<LinearEquations>([&] { return linearize(eq); });
-  progress.stage("checking the operating point");
-  check_operating_point(eq, lin);
+  if (d.eq->nonholonomic.active) options.dynamics = false;
   progress.stage("emitting the kernels");
   Emitted e;
-  e.code = emit(model, eq, lin, options, &ahead);
-  const auto& range = model.selection().frequency_range;
+  e.code = emit(d.model, *d.eq, *d.lin, options, &ahead);
+  const auto& range = d.model.selection().frequency_range;
   const double from = range ? range->from_hz : 0.0, to = range ? range->to_hz : 0.0;
   const int points = range ? range->points : 0;
   const bool linear_spacing = range ? !range->logarithmic : false;
-  e.api = emit_api(model, lin, e.code, scene, from, to, points, linear_spacing);
-  e.tape = emit_tape(model, lin, e.code, scene, from, to, points, linear_spacing);
-  e.id = full.name();
+  e.api = emit_api(d.model, *d.lin, e.code, scene, from, to, points, linear_spacing);
+  e.tape = emit_tape(d.model, *d.lin, e.code, scene, from, to, points, linear_spacing);
+  e.id = d.model.name();
   return e;
 }
 
