@@ -40,12 +40,6 @@
 
 extern char** environ;
 
-#ifdef MBSGEN_RUN_AVAILABLE
-namespace mbsgen::cli {
-// The solver over a tape file (runtime/cli/solver_cli.hpp; the tool links the solver library).
-int tape_solver_main(const std::string& tape_file, int argc, char** argv);
-}  // namespace mbsgen::cli
-#endif
 
 namespace mbsgen::tool {
 
@@ -408,6 +402,7 @@ Emitted emit_model(const std::string& model_file, const std::string& scene, bool
   options.parts = parts;
   if (parts == 0) options.chunk_operations = 0;  // a tape: nothing is compiled, no kernel is cut
   options.dynamics = dynamics;
+  options.solver_only = true;  // bodies and linear_structured: for the C API, never the solver's
   KernelsAhead ahead;
   Derivation& d = derivation(model_file, scene, sensitivity, options, ahead, progress);
   // A model with rolling constraints has no second-order form: its solver refuses `simulate`.
@@ -589,11 +584,16 @@ std::optional<int> run_tape(const std::string& model_file, const std::string& sc
   }
   std::error_code ec;
   if (fs::file_size(dir / "tape", ec) == 0 && !ec) return std::nullopt;  // closed loops
-  std::string name = entry_id(dir, model_file) + "-solve";
-  std::vector<char*> argv{name.data()};
+  // mbsgen-tape beside this mbsgen (installed), else the one of its build tree.
+  fs::path solver = fs::read_symlink("/proc/self/exe", ec).parent_path() / MBSGEN_TAPE_SOLVER_NAME;
+  if (!fs::is_regular_file(solver, ec)) solver = MBSGEN_BUILD_TAPE_SOLVER;
+  std::string program = solver.string(), tape = (dir / "tape").string();
+  std::vector<char*> argv{program.data(), tape.data()};
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  return mbsgen::cli::tape_solver_main((dir / "tape").string(), static_cast<int>(argv.size() - 1), argv.data());
+  ::execv(solver.c_str(), argv.data());
+  std::cerr << "mbsgen run: error: cannot execute " << solver.string() << ": " << std::strerror(errno) << "\n";
+  return 1;
 }
 
 }  // namespace

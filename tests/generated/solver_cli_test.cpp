@@ -429,6 +429,15 @@ TEST(SolverCli, RunAnswersFromATapeAsTheCompiledSolverDoes) {
     EXPECT_GT(tape.size(), 20u) << tape;
     EXPECT_EQ(tape, compiled);
   }
+  // A scene's tape, and an error path (the scene has no linear kernel: it once crashed the tape's
+  // first host, which held the generator's and the runtime's OperatingPoint in one program).
+  const std::string rotor = std::string("'") + MBSGEN_SOURCE_DIR + "/models/textbook/rotor_disk.yaml' --scene motion -- ";
+  const std::string rotor_solver = std::string("'") + MBSGEN_GENERATED_BIN_DIR + "/rotor_disk_motion-solve' ";
+  auto after_name = [](const std::string& text) { return text.substr(text.find(": ")); };  // (paths differ)
+  for (const std::string command : {"modes", "frf --input T --output tilt_x --points 5"})
+    EXPECT_EQ(after_name(capture(mbsgen + rotor + command + " 2>&1; echo status $?")),
+              after_name(capture(rotor_solver + command + " 2>&1; echo status $?")))
+        << command;
   const std::string model = std::string("'") + MBSGEN_SOURCE_DIR + "/models/textbook/double_pendulum.yaml'";
   EXPECT_NE(capture(mbsgen + model + " -- info").find("\nkernels: tape (evaluated without a compiler)\n"),
             std::string::npos);
@@ -436,6 +445,11 @@ TEST(SolverCli, RunAnswersFromATapeAsTheCompiledSolverDoes) {
   for (const auto& e : std::filesystem::directory_iterator(cache)) {
     solvers += std::filesystem::exists(e.path() / "solve");
     tapes += std::filesystem::exists(e.path() / "tape");
+    // Only the kernels a solver calls (EmitOptions::solver_only): not bodies, linear_structured.
+    std::ifstream in(e.path() / "tape");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text.find("\nkernel bodies "), std::string::npos) << e.path();
+    EXPECT_EQ(text.find("\nkernel linear_structured "), std::string::npos) << e.path();
   }
   EXPECT_EQ(solvers, 0) << "a compiler ran";
   EXPECT_GE(tapes, 5);

@@ -1452,7 +1452,7 @@ std::vector<Kernel> derivation_only_kernels(const Model& model, const Equations&
   const std::vector<ex> y(eq.y.begin(), eq.y.end()), yd(eq.yd.begin(), eq.yd.end()), p(eq.p.begin(), eq.p.end());
   std::vector<Kernel> all, kernels;
   derivation_kernels(eq, y, yd, p, eq.y.size(), wants_dynamics(scene, options), all);
-  all.push_back(bodies_kernel(eq, model.bodies().size(), y, p, eq.y.size()));
+  if (!options.solver_only) all.push_back(bodies_kernel(eq, model.bodies().size(), y, p, eq.y.size()));
   for (Kernel& k : all)
     if (scene.emits(scene_kernel(k.name))) kernels.push_back(std::move(k));
   return kernels;
@@ -1569,6 +1569,7 @@ GeneratedCode emit(const Model& model, Equations& eq, const LinearEquations& lin
   bool split_needed = false;
   for (const auto& k0 : kernels) {
     if (!scene.emits(scene_kernel(k0.name))) continue;
+    if (options.solver_only && (k0.name == "bodies" || k0.name == "linear_structured")) continue;
     Kernel k = k0;
     if (k.computed_by == "linear") {
       if (!scene.emits("linear"))

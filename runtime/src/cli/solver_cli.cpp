@@ -583,10 +583,16 @@ int tape_solver_main(const std::string& tape_file, int argc, char** argv) {
   try {
     tape = TapeModel::load(tape_file);
   } catch (const Error& e) {
-    std::cerr << (argc > 0 ? argv[0] : "mbsgen") << ": " << e.what() << "\n";
+    std::cerr << "mbsgen-tape: " << e.what() << "\n";
     return 1;
   }
-  return solver_main(tape->kernels(), argc, argv, std::cout, std::cerr);
+  // Named as the model's compiled solver is, in messages and usage.
+  std::string name = std::string(tape->kernels().model) + "-solve";
+  std::vector<char*> args(argv, argv + argc);
+  if (args.empty()) args.push_back(nullptr);
+  args[0] = name.data();
+  args.push_back(nullptr);
+  return solver_main(tape->kernels(), argc > 0 ? argc : 1, args.data(), std::cout, std::cerr);
 }
 
 }  // namespace mbsgen::cli

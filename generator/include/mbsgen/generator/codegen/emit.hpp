@@ -52,6 +52,10 @@ struct EmitOptions {
   /// state (the iteration matrices of implicit integration; not for closed loops). Off by
   /// default: it compiles M and k − q again and the Jacobian is 2–3 times `linear`'s size.
   bool dynamics = false;
+  /// Only the kernels a solver calls through ModelKernels (issue 40 §2): not `bodies` nor
+  /// `linear_structured`, which are for consumers of the C API (`mbsgen run`'s solvers and tapes;
+  /// the 30-link per-link chain's `bodies` is 17,174 operations, 359 kB of C++).
+  bool solver_only = false;
 };
 
 struct KernelInfo {

@@ -29,7 +29,8 @@ int solver_main(const ModelKernels& kernels, int argc, char** argv, std::ostream
 int solver_main(const ModelKernels& kernels, int argc, char** argv);
 
 /// The solver of the model in a tape file (model/tape.hpp), evaluated without a compiler: what
-/// `mbsgen run` answers with (issue 40 §1). A tape that cannot be read: a message, 1.
+/// `mbsgen run` answers with (issue 40 §1, through the program mbsgen-tape). argv[0] is replaced
+/// by `<model>-solve`. A tape that cannot be read: a message, 1.
 int tape_solver_main(const std::string& tape_file, int argc, char** argv);
 
 }  // namespace mbsgen::cli
