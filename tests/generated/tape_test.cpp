@@ -256,17 +256,11 @@ TEST(TapeModel, ForwardSensitivitiesAgreeWithTheSymbolicKernel) {
     ASSERT_EQ(a.size(), b.size());
     for (std::size_t j = 0; j < a.size(); ++j) {
       const std::string what = "d/d" + a[j].parameter;
-      expect_close(a[j].M, b[j].M, what + " M");
-      expect_close(a[j].Q, b[j].Q, what + " Q");
-      expect_close(a[j].K, b[j].K, what + " K");
-      expect_close(a[j].B, b[j].B, what + " B");
-      expect_close(a[j].C_y, b[j].C_y, what + " C_y");
-      expect_close(a[j].C_v, b[j].C_v, what + " C_v");
-      expect_close(a[j].C_a, b[j].C_a, what + " C_a");
-      expect_close(a[j].D, b[j].D, what + " D");
-      expect_close(a[j].B1, b[j].B1, what + " B1");
-      expect_close(a[j].B2, b[j].B2, what + " B2");
-      expect_close(a[j].D1, b[j].D1, what + " D1");
+      using S = mbsgen::MatrixSensitivity;
+      const std::initializer_list<std::pair<const char*, Eigen::MatrixXd S::*>> matrices = {
+          {"M", &S::M},     {"Q", &S::Q}, {"K", &S::K},   {"B", &S::B},   {"C_y", &S::C_y}, {"C_v", &S::C_v},
+          {"C_a", &S::C_a}, {"D", &S::D}, {"B1", &S::B1}, {"B2", &S::B2}, {"D1", &S::D1}};
+      for (const auto& [name, m] : matrices) expect_close(a[j].*m, b[j].*m, what + " " + name);
       expect_close(a[j].dy0, b[j].dy0, what + " y0");
       expect_close(a[j].dyd0, b[j].dyd0, what + " yd0");
     }
