@@ -101,6 +101,7 @@ std::vector<Case> read_cases(const fs::path& path) {
 std::string program(const std::string& name) {
   if (name == "mbsgen") return std::string(MBSGEN_TOOL_DIR) + "/mbsgen";
   if (name == "mbsgen-linear") return MBSGEN_LINEAR_EXE;
+  if (name == "mbsgen-tape") return MBSGEN_TAPE_EXE;
   return std::string(MBSGEN_GENERATED_BIN_DIR) + "/" + name;
 }
 
