@@ -84,6 +84,20 @@ int run_info(const ModelKernels& k, const Options& o, std::ostream& out) {
         << " " << unit_or(k.parameter_units, i, "") << "\n";
   out << "kernels: " << (k.evaluation ? std::string(k.evaluation) + " (evaluated without a compiler)" : "compiled")
       << "\n";
+  // The kernels this solver has (issue 40 §2: made on demand; `mbsgen info` has their sizes).
+  const std::vector<std::pair<const char*, bool>> kernels = {
+      {"operating_point", k.operating_point != nullptr}, {"linear", k.linear != nullptr},
+      {"residual", k.residual != nullptr}, {"mass_matrix", k.mass_matrix != nullptr},
+      {"outputs", k.outputs != nullptr}, {"output_terms", k.output_terms != nullptr},
+      {"outputs_general", k.outputs_general != nullptr}, {"descriptor", k.descriptor != nullptr},
+      {"reduced", k.reduced != nullptr}, {"reduced_parts", k.reduced_parts != nullptr},
+      {"dynamics", k.dynamics != nullptr}, {"dynamics_jacobian", k.dynamics_jacobian != nullptr},
+      {"assemble", k.assemble != nullptr}, {"excitation", k.excitation != nullptr},
+      {"sensitivity", k.sensitivity != nullptr}, {"physical", k.physical != nullptr}};
+  out << "kernels built:";
+  for (const auto& [name, built] : kernels)
+    if (built) out << " " << name;
+  out << "\n";
   return 0;
 }
 
