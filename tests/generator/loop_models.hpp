@@ -36,7 +36,7 @@ inline void add_marker(Model& m, const std::string& name, const std::string& bod
 // world at O = 0 and D = (a, 0), the coupler (th2, relative to the crank) joined to the
 // rocker's tip by a revolute constraint. Equal crank and rocker (length l, mass mb) and a = the
 // coupler's length make a parallelogram.
-inline Model four_bar(double a, double l1, double l2, double l3, const OperatingPoint& op,
+inline Model four_bar(double a, double l1, double l2, double l3, const LinearizationPoint& op,
                const std::vector<std::string>& independent = {}) {
   Model m("four_bar");
   const ex g = m.add_parameter("g", 9.81), mb = m.add_parameter("mb", 0.5), mc = m.add_parameter("mc", 0.8);
@@ -66,8 +66,8 @@ inline Model four_bar(double a, double l1, double l2, double l3, const Operating
   return m;
 }
 
-inline OperatingPoint hanging() {
-  OperatingPoint op;
+inline LinearizationPoint hanging() {
+  LinearizationPoint op;
   op.position = {{"th1", -GiNaC::Pi / 2}, {"th2", GiNaC::Pi / 2}, {"th3", -GiNaC::Pi / 2}};
   return op;
 }
@@ -106,7 +106,7 @@ inline Model cartesian_pendulum(bool as_expression, const std::vector<std::strin
   std::vector<SceneItem> items;
   for (const auto& name : independent) items.push_back({name, {}});
   m.set_independent_coordinates(items);
-  OperatingPoint op;
+  LinearizationPoint op;
   op.position = {{"x", 0}, {"y", -L}};
   m.set_operating_point(op);
   m.validate();

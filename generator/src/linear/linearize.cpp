@@ -218,8 +218,8 @@ LinearEquations linearize(Equations& eq) {
   LinearEquations lin;
   std::size_t f = eq.y.size();
 
-  const OperatingPoint& op = model.operating_point();
-  lin.equilibrium = op.kind == OperatingPoint::Kind::equilibrium;
+  const LinearizationPoint& op = model.operating_point();
+  lin.equilibrium = op.kind == LinearizationPoint::Kind::equilibrium;
   for (const auto& c : model.coordinates()) {
     auto p = op.position.find(c.name);
     lin.y0.push_back(p == op.position.end() ? ex(0) : p->second);

@@ -86,7 +86,7 @@ GiNaC::exmap defaults_at_operating_point(const Model& model, const Equations& eq
   GiNaC::exmap p, values;
   for (std::size_t k = 0; k < eq.p.size(); ++k) p[eq.p[k]] = GiNaC::numeric(model.parameters()[k].value);
   values = p;
-  const OperatingPoint& op = model.operating_point();
+  const LinearizationPoint& op = model.operating_point();
   for (std::size_t k = 0; k < eq.y.size(); ++k) {
     const auto& name = model.coordinates()[k].name;
     auto closed = eq.loops.closed_at_defaults.find(eq.y[k]);

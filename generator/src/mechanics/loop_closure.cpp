@@ -143,7 +143,7 @@ GiNaC::exmap operating_point_values(const Model& model, const Equations& eq) {
   GiNaC::exmap p, values;
   for (std::size_t k = 0; k < eq.p.size(); ++k) p[eq.p[k]] = GiNaC::numeric(model.parameters()[k].value);
   values = p;
-  const OperatingPoint& op = model.operating_point();
+  const LinearizationPoint& op = model.operating_point();
   for (std::size_t k = 0; k < eq.y.size(); ++k) {
     auto it = op.position.find(model.coordinates()[k].name);
     values[eq.y[k]] = it == op.position.end() ? ex(0) : GiNaC::evalf(it->second.subs(p, GiNaC::subs_options::no_pattern));
@@ -339,7 +339,7 @@ void drop_redundant(const Model& model, Equations& eq, std::vector<RawEquation>&
 // 1 for directions and expressions), so that coordinates written with 9 digits close the loop;
 // the kernels then refine the dependent coordinates to full precision by Newton's method.
 void check_closure(const Model& model, const std::vector<RawEquation>& raw, const Numbers& at_op) {
-  if (model.operating_point().kind != OperatingPoint::Kind::given) return;
+  if (model.operating_point().kind != LinearizationPoint::Kind::given) return;
   for (std::size_t k = 0; k < raw.size(); ++k) {
     const double tol = 1e-8 * at_op.size[k];
     if (std::abs(at_op.phi[k]) <= tol) continue;

@@ -597,7 +597,7 @@ void Model::validate_velocity_constraints() const {
     if (o.kind == OutputKind::reaction && nonholonomic())
       throw ModelError(o.where, "output '" + o.name + "': reaction outputs are not available in a model with "
                                 "nonholonomic constraints (rolling wheels) yet");
-  if (nonholonomic() && operating_point_.kind == OperatingPoint::Kind::equilibrium)
+  if (nonholonomic() && operating_point_.kind == LinearizationPoint::Kind::equilibrium)
     throw ModelError(operating_point_.where, "a model with nonholonomic constraints is linearized at a given operating point "
                                              "(rest or a steady motion), not at an equilibrium to be found");
 }
@@ -733,7 +733,7 @@ void check_force_elements(const Model& model, const std::set<std::string>& known
 
 // Checks that the operating point names coordinates and depends on parameters only.
 void check_operating_point_values(const Model& model, const std::set<std::string>& parameters_only) {
-  const OperatingPoint& op = model.operating_point();
+  const LinearizationPoint& op = model.operating_point();
   for (const auto& [name, value] : op.position) {
     if (model.coordinate_index(name) < 0)
       throw ModelError(op.where, "operating point names an unknown coordinate '" + name + "'");

@@ -178,8 +178,8 @@ Model four_bar_linkage() {
   const double dx = a - Ax, dy = -Ay, d = std::hypot(dx, dy);
   const double along = (l2 * l2 - l3 * l3 + d * d) / (2 * d), h = std::sqrt(l2 * l2 - along * along);
   const double Bx = Ax + (along * dx - h * dy) / d, By = Ay + (along * dy + h * dx) / d;
-  OperatingPoint op;
-  op.kind = OperatingPoint::Kind::equilibrium;
+  LinearizationPoint op;
+  op.kind = LinearizationPoint::Kind::equilibrium;
   op.position = {{"th1", theta1},
                  {"th2", std::atan2(By - Ay, Bx - Ax) - theta1},
                  {"th3", std::atan2(By, Bx - a)}};
@@ -192,7 +192,7 @@ Model ladder(int n) {
   const GiNaC::ex g = model.add_parameter("g", 9.81, "m/s^2"), h = model.add_parameter("h", 0.2, "m"),
                   w = model.add_parameter("w", 0.3, "m"), m = model.add_parameter("m", 0.2, "kg"),
                   k = model.add_parameter("k", 2.0, "N m/rad");
-  OperatingPoint op;
+  LinearizationPoint op;
   for (int i = 1; i <= n; ++i) {
     const std::string s = std::to_string(i);
     for (const char* side : {"a", "b"}) {

@@ -282,17 +282,17 @@ void select_analyses(SceneSelection& sel, const Model& model, const Scene& scene
 }
 
 // Overrides the operating point `point` per coordinate, adding the kernels its equilibrium needs.
-void override_operating_point(OperatingPoint& point, SceneSelection& sel, const Model& model,
+void override_operating_point(LinearizationPoint& point, SceneSelection& sel, const Model& model,
                               const OperatingPointOverride& op) {
   if (op.kind) point.kind = *op.kind;
   // A simulation's equilibrium takes its Jacobian from dynamics_jacobian, which a model with
   // loops does not have: `linear` then.
-  if (sel.asks(Analysis::simulate) && point.kind == OperatingPoint::Kind::equilibrium &&
+  if (sel.asks(Analysis::simulate) && point.kind == LinearizationPoint::Kind::equilibrium &&
       !model.constraints().empty() && !sel.emits("linear"))
     sel.kernels.insert(std::find(sel.kernels.begin(), sel.kernels.end(), "residual") + 1, "linear");
   // Any analysis at an equilibrium finds it first, by Newton's method on `residual`: without it
   // the runtime would linearize at the initial guess (a modes-only or sensitivity scene).
-  if (point.kind == OperatingPoint::Kind::equilibrium && sel.emits("linear") && !sel.emits("residual"))
+  if (point.kind == LinearizationPoint::Kind::equilibrium && sel.emits("linear") && !sel.emits("residual"))
     sel.kernels.insert(std::find(sel.kernels.begin(), sel.kernels.end(), "linear"), "residual");
   for (const auto& [c, v] : op.position) point.position[c] = v;
   for (const auto& [c, v] : op.velocity) point.velocity[c] = v;

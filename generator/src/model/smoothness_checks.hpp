@@ -22,8 +22,8 @@ namespace mbsgen::detail {
 /// point is only a guess for an equilibrium), rates, and inputs 0.
 inline GiNaC::exmap operating_point_values(const Model& model, const GiNaC::exmap& parameters) {
   GiNaC::exmap values = parameters;
-  const OperatingPoint& op = model.operating_point();
-  const bool given = op.kind == OperatingPoint::Kind::given;
+  const LinearizationPoint& op = model.operating_point();
+  const bool given = op.kind == LinearizationPoint::Kind::given;
   for (const auto& c : model.coordinates()) {
     const auto p = op.position.find(c.name);
     const auto v = op.velocity.find(c.name);
@@ -243,7 +243,7 @@ inline std::vector<std::optional<NumVec>> marker_positions(const Model& model, c
 /// markers coincide (|r_B − r_A|² <= 1e-30 (|r_A|² + |r_B|²), in 50 digits): its direction is
 /// undefined there (a zero-length spring, V = k L²/2, needs none).
 inline void check_force_directions(const Model& model, const GiNaC::exmap& parameters) {
-  if (model.operating_point().kind != OperatingPoint::Kind::given) return;
+  if (model.operating_point().kind != LinearizationPoint::Kind::given) return;
   bool any = !model.dampers().empty();
   for (const auto& s : model.springs()) any = any || !s.rest_length.is_zero();
   if (!any) return;

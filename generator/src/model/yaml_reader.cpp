@@ -1551,9 +1551,9 @@ void Reader::read_reduced_form(const Entry& e) {
 void Reader::read_operating_point(const Entry& e) {
   const YAML::Node& n = value(e);
   const OperatingPointOverride values = read_operating_point_values(n, "the operating point");
-  OperatingPoint op;
+  LinearizationPoint op;
   op.where = values.where;
-  op.kind = values.kind.value_or(OperatingPoint::Kind::given);
+  op.kind = values.kind.value_or(LinearizationPoint::Kind::given);
   op.position = values.position;
   op.velocity = values.velocity;
   model_->set_operating_point(op);
@@ -1566,8 +1566,8 @@ OperatingPointOverride Reader::read_operating_point_values(const YAML::Node& n, 
   if (const Entry* t = find(f, "type")) {
     const YAML::Node& tn = value(*t);
     const std::string type = scalar(tn, "an operating point type (given or equilibrium)");
-    if (type == "given") op.kind = OperatingPoint::Kind::given;
-    else if (type == "equilibrium") op.kind = OperatingPoint::Kind::equilibrium;
+    if (type == "given") op.kind = LinearizationPoint::Kind::given;
+    else if (type == "equilibrium") op.kind = LinearizationPoint::Kind::equilibrium;
     else fail(tn, "unknown operating point type '" + type + "' (given or equilibrium)");
   }
   auto values = [&](const char* key, std::map<std::string, GiNaC::ex>& out) {

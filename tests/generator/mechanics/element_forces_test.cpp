@@ -62,7 +62,7 @@ Model spring_mass() {
   m.add_output(force("spring_fx", {"spring"}, {1, 0, 0}));
   m.add_output(force("damper_fy", {"damper"}, {0, 1, 0}));
   m.add_output(force("both_fy", {"spring", "damper"}, {0, 1, 0}));
-  OperatingPoint op;
+  LinearizationPoint op;
   op.position = {{"x", 0}, {"y", -(L0 + mass * g / k)}};
   m.set_operating_point(op);
   m.validate();

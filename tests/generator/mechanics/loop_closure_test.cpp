@@ -111,7 +111,7 @@ TEST(LoopClosure, RedundantConstraintsAreDroppedAndSaidSo) {
 // Crank and coupler stretched along x with the rocker in line: every constraint gradient is
 // along y, so the Jacobian has rank 1 at this dead point (rank 2 elsewhere).
 TEST(LoopClosure, DeadPointIsNamed) {
-  OperatingPoint op;
+  LinearizationPoint op;
   op.position = {{"th1", 0}, {"th2", 0}, {"th3", 0}};
   const std::string e = error_of([&] {
     Model m = four_bar(0.4, 0.1, 0.35, 0.05, op);
@@ -127,7 +127,7 @@ TEST(LoopClosure, DeadPointIsNamed) {
 }
 
 TEST(LoopClosure, GivenOperatingPointMustCloseTheLoop) {
-  OperatingPoint op = hanging();
+  LinearizationPoint op = hanging();
   op.position["th3"] = -GiNaC::Pi / 2 + GiNaC::numeric(1, 100);
   const std::string e = error_of([&] {
     Model m = four_bar(0.3, 0.2, 0.3, 0.2, op);

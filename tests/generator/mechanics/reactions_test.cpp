@@ -131,7 +131,7 @@ TEST(Reactions, StaticLoadsEqualTheWeightCarried) {
 TEST(Reactions, LinearRowsMatchTheNonlinearLoad) {
   Model m = double_pendulum();
   Equations eq = derive(m);
-  OperatingPoint op;
+  LinearizationPoint op;
   op.position = {{"q1", -GiNaC::Pi / 2}, {"q2", 0}};
   m.set_operating_point(op);
   Equations eq2 = derive(m);
@@ -249,7 +249,7 @@ TEST(Reactions, BlockOnAnInclinedGuide) {
   // Equilibrium along the guide: the compressed spring pushes up the slope, k (L0 − L) = m g sin α
   // with L = 1 + s.
   const double s = L0 - mass * g * std::sin(alpha) / k - 1.0;
-  OperatingPoint op;
+  LinearizationPoint op;
   op.position = {{"x", s * std::cos(alpha)}, {"y", s * std::sin(alpha)}, {"th", 0}};
   m.set_operating_point(op);
   Equations eq = derive(m);

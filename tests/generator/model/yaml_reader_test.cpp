@@ -134,7 +134,7 @@ TEST(DoublePendulum, ContentsAsWritten) {
   EXPECT_EQ(m.outputs()[1].kind, mbsgen::OutputKind::velocity);
   EXPECT_EQ(m.outputs()[2].kind, mbsgen::OutputKind::coordinate);
   EXPECT_EQ(m.outputs()[3].kind, mbsgen::OutputKind::expression);
-  EXPECT_EQ(m.operating_point().kind, mbsgen::OperatingPoint::Kind::given);
+  EXPECT_EQ(m.operating_point().kind, mbsgen::LinearizationPoint::Kind::given);
   // The body's location is the start of its map in the file.
   EXPECT_EQ(rod2.where.line, 35);
   EXPECT_EQ(rod2.where.column, 5);
@@ -335,7 +335,7 @@ TEST(Defaults, ForceNamesAreTypeAndIndexAndUnique) {
   EXPECT_EQ(m.parameters()[1].unit, "kg");
   EXPECT_EQ(m.parameters()[1].value, 2.0);
   EXPECT_EQ(m.bodies()[0].parent, mbsgen::kWorld);
-  EXPECT_EQ(m.operating_point().kind, mbsgen::OperatingPoint::Kind::given);
+  EXPECT_EQ(m.operating_point().kind, mbsgen::LinearizationPoint::Kind::given);
   EXPECT_TRUE(m.operating_point().position.empty());
 }
 

@@ -257,7 +257,7 @@ struct Output {
 
 /// Where the model is linearized: given values, or a static equilibrium found from a guess;
 /// steady velocities (zero unless given) allow steady motions such as a spinning rotor.
-struct OperatingPoint {
+struct LinearizationPoint {
   enum class Kind { given, equilibrium };
   Kind kind = Kind::given;
   std::map<std::string, GiNaC::ex> position;  ///< coordinate name → value (or initial guess)
@@ -295,7 +295,7 @@ struct FrequencyRange {
 /// Changes a scene makes to the model's operating point: the given entries replace the model's
 /// (per coordinate); the rest are kept.
 struct OperatingPointOverride {
-  std::optional<OperatingPoint::Kind> kind;
+  std::optional<LinearizationPoint::Kind> kind;
   std::map<std::string, GiNaC::ex> position;
   std::map<std::string, GiNaC::ex> velocity;
   SourceLocation where;
@@ -457,7 +457,7 @@ class Model {
   /// that has named parts must be their sum).
   void set_reduced_coefficients(std::vector<NamedCoefficient> c) { reduced_coefficients_ = std::move(c); }
   const std::vector<NamedCoefficient>& reduced_coefficients() const { return reduced_coefficients_; }
-  void set_operating_point(OperatingPoint op) { operating_point_ = std::move(op); }
+  void set_operating_point(LinearizationPoint op) { operating_point_ = std::move(op); }
   /// The full scene with the `sensitivity` kernel too, by `parameters` (empty: all), in the
   /// model's order (issue 40 §2: made only when asked). std::invalid_argument for an unknown
   /// parameter (listing the known ones) or a model pruned for a scene (whose analyses say whether
@@ -507,7 +507,7 @@ class Model {
   /// True when the motion has nonholonomic constraints (velocity constraints or rolling wheels):
   /// the linear model is then first order, E ẋ = A x + B u (nonholonomic.hpp).
   bool nonholonomic() const;
-  const OperatingPoint& operating_point() const { return operating_point_; }
+  const LinearizationPoint& operating_point() const { return operating_point_; }
   const std::vector<Scene>& scenes() const { return scenes_; }
   /// The scene of that name, or nullptr (also for the implicit "full").
   const Scene* scene(const std::string& name) const;
@@ -576,7 +576,7 @@ class Model {
   std::vector<VelocityConstraint> velocity_constraints_;
   std::vector<SceneItem> independent_speeds_;
   std::vector<NamedCoefficient> reduced_coefficients_;
-  OperatingPoint operating_point_;
+  LinearizationPoint operating_point_;
   std::vector<Scene> scenes_;
   bool inertial_velocity_terms_ = true;
   SceneSelection selection_;
