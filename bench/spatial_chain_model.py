@@ -33,6 +33,33 @@ SHARED = [("l", 0.3, "m", 1), ("m", 0.8, "kg", 1), ("Ixx", 6.0e-3, "kg m^2", 3),
           ("Iyz", 1.5e-4, "kg m^2", 3)]
 
 
+def structure(n, name):
+    """The coordinates, bodies and forces of the n-link chain; name(p, i) is link i's parameter p
+    ("k" and "c" with the joint axis appended: "ka", "cb")."""
+    out = ["", "coordinates:"]
+    for i in range(1, n + 1):
+        out += ["  - {name: a%d, unit: rad}" % i, "  - {name: b%d, unit: rad}" % i]
+    out += ["", "bodies:"]
+    for i in range(1, n + 1):
+        out += ["  - name: link%d" % i,
+                "    parent: %s" % ("world" if i == 1 else "link%d" % (i - 1)),
+                "    translation: %s" % ("[0, 0, 0]" if i == 1 else "[0, 0, -%s]" % name("l", i - 1)),
+                "    rotation: [{x: a%d}, {y: b%d}]" % (i, i),
+                "    mass: %s" % name("m", i),
+                "    com: [0, 0, -%s/2]" % name("l", i),
+                "    inertia: [[{0}, {1}, {2}], [{1}, {3}, {4}], [{2}, {4}, {5}]]".format(
+                    *(name(p, i) for p in ("Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")))]
+    out += ["", "forces:", "  - {name: gravity, type: gravity, g: [0, 0, -g]}"]
+    for i in range(1, n + 1):
+        for q in ("a", "b"):
+            c = "%s%d" % (q, i)
+            out.append("  - {name: spring_%s, type: generalized, coordinate: %s, value: -%s*%s, category: springs}"
+                       % (c, c, name("k" + q, i), c))
+            out.append("  - {name: damper_%s, type: generalized, coordinate: %s, value: -%s*%s_dot, category: dampers}"
+                       % (c, c, name("c" + q, i), c))
+    return out
+
+
 def per_link_yaml(n):
     """The chain with every link's own parameters (--per-link)."""
     out = [HEADER + " --links %d --per-link: a spatial chain with every link's own parameters." % n,
@@ -44,26 +71,7 @@ def per_link_yaml(n):
         for q in ("a", "b"):
             out.append("  k%s_%d: {value: %.10g, unit: N m/rad}" % (q, i, 20 * f))
             out.append("  c%s_%d: {value: %.10g, unit: N m s/rad}" % (q, i, 0.05 * f))
-    out += ["", "coordinates:"]
-    for i in range(1, n + 1):
-        out += ["  - {name: a%d, unit: rad}" % i, "  - {name: b%d, unit: rad}" % i]
-    out += ["", "bodies:"]
-    for i in range(1, n + 1):
-        out += ["  - name: link%d" % i,
-                "    parent: %s" % ("world" if i == 1 else "link%d" % (i - 1)),
-                "    translation: %s" % ("[0, 0, 0]" if i == 1 else "[0, 0, -l_%d]" % (i - 1)),
-                "    rotation: [{x: a%d}, {y: b%d}]" % (i, i),
-                "    mass: m_%d" % i,
-                "    com: [0, 0, -l_%d/2]" % i,
-                "    inertia: [[Ixx_{0}, Ixy_{0}, Ixz_{0}], [Ixy_{0}, Iyy_{0}, Iyz_{0}], [Ixz_{0}, Iyz_{0}, Izz_{0}]]".format(i)]
-    out += ["", "forces:", "  - {name: gravity, type: gravity, g: [0, 0, -g]}"]
-    for i in range(1, n + 1):
-        for q in ("a", "b"):
-            c = "%s%d" % (q, i)
-            out.append("  - {name: spring_%s, type: generalized, coordinate: %s, value: -k%s_%d*%s, category: springs}"
-                       % (c, c, q, i, c))
-            out.append("  - {name: damper_%s, type: generalized, coordinate: %s, value: -c%s_%d*%s_dot, category: dampers}"
-                       % (c, c, q, i, c))
+    out += structure(n, lambda p, i: "%s_%d" % (p, i))
     return "\n".join(out) + "\n"
 
 
@@ -82,27 +90,8 @@ def chain_yaml(n):
            "  Ixz: {value: -1.0e-4, unit: kg m^2}",
            "  Iyz: {value: 1.5e-4, unit: kg m^2}",
            "  k: {value: 20, unit: N m/rad}",
-           "  c: {value: 0.05, unit: N m s/rad}",
-           "",
-           "coordinates:"]
-    for i in range(1, n + 1):
-        out += ["  - {name: a%d, unit: rad}" % i, "  - {name: b%d, unit: rad}" % i]
-    out += ["", "bodies:"]
-    for i in range(1, n + 1):
-        out += ["  - name: link%d" % i,
-                "    parent: %s" % ("world" if i == 1 else "link%d" % (i - 1)),
-                "    translation: %s" % ("[0, 0, 0]" if i == 1 else "[0, 0, -l]"),
-                "    rotation: [{x: a%d}, {y: b%d}]" % (i, i),
-                "    mass: m",
-                "    com: [0, 0, -l/2]",
-                "    inertia: [[Ixx, Ixy, Ixz], [Ixy, Iyy, Iyz], [Ixz, Iyz, Izz]]"]
-    out += ["", "forces:", "  - {name: gravity, type: gravity, g: [0, 0, -g]}"]
-    for i in range(1, n + 1):
-        for q in ("a%d" % i, "b%d" % i):
-            out.append("  - {name: spring_%s, type: generalized, coordinate: %s, value: -k*%s, category: springs}"
-                       % (q, q, q))
-            out.append("  - {name: damper_%s, type: generalized, coordinate: %s, value: -c*%s_dot, category: dampers}"
-                       % (q, q, q))
+           "  c: {value: 0.05, unit: N m s/rad}"]
+    out += structure(n, lambda p, i: p[0] if p[0] in "kc" and len(p) == 2 else p)
     out += ["", "scenes:",
             "  - name: no_damping",
             "    description: modes without the joint dampers",

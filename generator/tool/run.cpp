@@ -472,19 +472,17 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
 
 // Generates the tape of model_file into the cache entry dir (make_entry): the file "tape", empty
 // for a model with closed loops (which only a compiled solver evaluates).
-void build_tape(const std::string& model_file, const std::string& scene,
-                const std::optional<std::vector<std::string>>& sensitivity, const std::string& text,
-                const fs::path& dir, Progress& progress) {
+void build_tape(const std::string& model_file, const std::string& scene, const std::string& text, const fs::path& dir,
+                Progress& progress) {
   // A joint or distance constraint closes a loop: known without deriving (rolling contacts may or
   // may not leave a holonomic condition, which only the derivation tells).
   const Model model = apply_scene(read_model_file(model_file), scene);
   const bool loops = std::any_of(model.constraints().begin(), model.constraints().end(),
                                  [](const Constraint& c) { return c.kind != ConstraintKind::rolling; });
-  Emitted e;
-  if (loops) e.id = model.name();
-  else e = emit_model(model_file, scene, false, sensitivity, 0, progress);
+  // (The tape's sensitivities come by forward mode, model/tape.hpp: no symbolic kernel is asked for.)
+  const Emitted e = loops ? Emitted{} : emit_model(model_file, scene, false, std::nullopt, 0, progress);
   make_entry(dir, [&](const fs::path& work) {
-    write_files({{work / "tape", e.tape}, {work / "model.yaml", text}, {work / "id", e.id}});
+    write_files({{work / "tape", e.tape}, {work / "model.yaml", text}});
     write_files({{work / "tape.sum", solver_record(work / "tape")}});  // last: the entry is complete
     return true;
   });
@@ -549,51 +547,68 @@ std::string entry_id(const fs::path& dir, const std::string& model_file) {
   return id;
 }
 
+// The cache entry of key: a private directory of the cache, by the key's hash.
+fs::path entry_dir(const std::string& key) {
+  const fs::path root = cache_root();
+  ensure_private_directory(root);
+  return root / hex_key(key);
+}
+
+// Makes the cache entry dir hold a sound artifact ("solve", the compiled solver, or "tape"):
+// kept when it does, else reported when damaged and made by build(), which returns 0 or the exit
+// status to end with (returned).
+template <class Build>
+int ensure_entry(const fs::path& dir, const std::string& artifact, const std::string& model_file, Build&& build) {
+  const std::string noun = artifact == "solve" ? "solver" : artifact;
+  std::string why;
+  if (sound_entry(dir, why, artifact)) return 0;
+  if (!why.empty()) {
+    std::cerr << "mbsgen run: the cached " << noun << " " << dir.string() << " is damaged (" << why << "): rebuilding it\n";
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  if (const int status = build()) return status;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (::isatty(STDERR_FILENO))
+    std::cerr << "mbsgen run: " << (artifact == "solve" ? "built" : "generated") << " the " << noun << " of "
+              << model_file << " in " << std::setprecision(3) << seconds << " s\n";
+  why.clear();
+  if (!sound_entry(dir, why, artifact))
+    throw std::runtime_error("the " + noun + " just made in " + dir.string() + " is not sound (" + why + ")");
+  return 0;
+}
+
+// Replaces this process with program, given arguments first and then args; returns (1) only
+// when it cannot.
+int exec_program(const fs::path& program, std::string name, std::vector<std::string> given,
+                 std::vector<std::string>& args) {
+  std::vector<char*> argv{name.data()};
+  for (auto& a : given) argv.push_back(a.data());
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  ::execv(program.c_str(), argv.data());
+  std::cerr << "mbsgen run: error: cannot execute " << program.string() << ": " << std::strerror(errno) << "\n";
+  return 1;
+}
+
 // Runs args on the model's tape (issue 40 §1: no compiler), generating and caching it first;
 // nullopt when the model has no tape (closed loops): then a compiled solver answers.
 std::optional<int> run_tape(const std::string& model_file, const std::string& scene, std::vector<std::string>& args,
-                            const std::string& text, const std::optional<std::vector<std::string>>& sensitivity) {
-  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + "tape";
-  if (sensitivity) {
-    key += std::string(1, '\0') + "sensitivity";
-    for (const auto& name : *sensitivity) key += ',' + name;
-  }
-  key += exe_identity();
-  const fs::path root = cache_root();
-  ensure_private_directory(root);
-  const fs::path dir = root / hex_key(key);
-  std::string why;
-  if (!sound_entry(dir, why, "tape")) {
-    std::error_code ec;
-    if (!why.empty()) {
-      std::cerr << "mbsgen run: the cached tape " << dir.string() << " is damaged (" << why << "): rebuilding it\n";
-      fs::remove_all(dir, ec);
-    }
-    const auto t0 = std::chrono::steady_clock::now();
-    {
-      Progress progress("run");
-      build_tape(model_file, scene, sensitivity, text, dir, progress);
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (::isatty(STDERR_FILENO))
-      std::cerr << "mbsgen run: generated the tape of " << model_file << " in " << std::setprecision(3) << seconds
-                << " s\n";
-    why.clear();
-    if (!sound_entry(dir, why, "tape"))
-      throw std::runtime_error("the tape just made in " + dir.string() + " is not sound (" + why + ")");
-  }
+                            const std::string& text) {
+  const fs::path dir = entry_dir(text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + "tape" + exe_identity());
+  if (const int status = ensure_entry(dir, "tape", model_file, [&] {
+        Progress progress("run");
+        build_tape(model_file, scene, text, dir, progress);
+        return 0;
+      }))
+    return status;
   std::error_code ec;
   if (fs::file_size(dir / "tape", ec) == 0 && !ec) return std::nullopt;  // closed loops
   // mbsgen-tape beside this mbsgen (installed), else the one of its build tree.
   fs::path solver = fs::read_symlink("/proc/self/exe", ec).parent_path() / MBSGEN_TAPE_SOLVER_NAME;
   if (!fs::is_regular_file(solver, ec)) solver = MBSGEN_BUILD_TAPE_SOLVER;
-  std::string program = solver.string(), tape = (dir / "tape").string();
-  std::vector<char*> argv{program.data(), tape.data()};
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  ::execv(solver.c_str(), argv.data());
-  std::cerr << "mbsgen run: error: cannot execute " << solver.string() << ": " << std::strerror(errno) << "\n";
-  return 1;
+  return exec_program(solver, solver.string(), {(dir / "tape").string()}, args);
 }
 
 }  // namespace
@@ -618,9 +633,8 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   // The tape answers a one-off analysis; a compiled solver what runs the kernels many times
   // (simulate, study) and what is asked for with --compiled.
   const bool many_calls = !args.empty() && (args[0] == "simulate" || args[0] == "study");
-  // The tape's sensitivities come by forward mode (model/tape.hpp): it needs no symbolic kernel.
   if (!compiled && !many_calls) {
-    if (const std::optional<int> status = run_tape(model_file, scene, args, text, std::nullopt)) return *status;
+    if (const std::optional<int> status = run_tape(model_file, scene, args, text)) return *status;
   }
   const Toolchain tc = toolchain();
   // `simulate` needs the kernels of a time step (EmitOptions::dynamics: the dynamics Jacobian);
@@ -644,41 +658,19 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
     if (!ec) key += '\0' + std::to_string(size) + '\0' + std::to_string(time.time_since_epoch().count());
   }
   key += '\0' + std::string("/proc/self/exe") + exe_identity();
-  const fs::path root = cache_root();
-  ensure_private_directory(root);
-  const fs::path dir = root / hex_key(key);
-  std::string why;
-  if (!sound_entry(dir, why)) {
-    std::error_code ec;
-    if (!why.empty()) {
-      std::cerr << "mbsgen run: the cached solver " << dir.string() << " is damaged (" << why << "): rebuilding it\n";
-      fs::remove_all(dir, ec);
-    }
-    const auto t0 = std::chrono::steady_clock::now();
-    try {
-      TerminationGuard guard;
-      Progress progress("run");  // on a terminal, after 2 s: the stage, and files compiled
-      if (!build_solver(model_file, scene, dynamics, sensitivity, text, tc, dir, progress)) return 1;
-    } catch (const Terminated& t) {  // the children stopped, the build directory removed
-      std::cerr << "mbsgen run: " << t.what() << "; the solver was not built\n";
-      return 128 + t.signal;
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (::isatty(STDERR_FILENO))
-      std::cerr << "mbsgen run: built the solver of " << model_file << " in " << std::setprecision(3) << seconds
-                << " s\n";
-    why.clear();
-    if (!sound_entry(dir, why))
-      throw std::runtime_error("the solver just built in " + dir.string() + " is not sound (" + why + ")");
-  }
-  const fs::path solver = dir / "solve";
-  std::string name = entry_id(dir, model_file) + "-solve";
-  std::vector<char*> argv{name.data()};
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  ::execv(solver.c_str(), argv.data());
-  std::cerr << "mbsgen run: error: cannot execute " << solver.string() << ": " << std::strerror(errno) << "\n";
-  return 1;
+  const fs::path dir = entry_dir(key);
+  if (const int status = ensure_entry(dir, "solve", model_file, [&] {
+        try {
+          TerminationGuard guard;
+          Progress progress("run");  // on a terminal, after 2 s: the stage, and files compiled
+          return build_solver(model_file, scene, dynamics, sensitivity, text, tc, dir, progress) ? 0 : 1;
+        } catch (const Terminated& t) {  // the children stopped, the build directory removed
+          std::cerr << "mbsgen run: " << t.what() << "; the solver was not built\n";
+          return 128 + t.signal;
+        }
+      }))
+    return status;
+  return exec_program(dir / "solve", entry_id(dir, model_file) + "-solve", {}, args);
 #endif
 }
 

@@ -55,6 +55,13 @@ std::string format_double(double v) {
   return s;
 }
 
+std::vector<std::string> sensitivity_parameter_names(const Model& model) {
+  std::vector<std::string> names = model.selection().sensitivity_parameters;
+  if (names.empty())
+    for (const auto& q : model.parameters()) names.push_back(q.name);
+  return names;
+}
+
 namespace {
 
 std::string upper(std::string s) {
@@ -282,13 +289,6 @@ bool has_sensitivity_kernel(const GeneratedCode& out) {
   return std::any_of(out.kernels.begin(), out.kernels.end(), [](const KernelInfo& k) { return k.name == "sensitivity"; });
 }
 
-// The parameters of the sensitivity kernel: the scene's, or all, in the model's order.
-std::vector<std::string> sensitivity_parameter_names(const Model& model) {
-  std::vector<std::string> names = model.selection().sensitivity_parameters;
-  if (names.empty())
-    for (const auto& q : model.parameters()) names.push_back(q.name);
-  return names;
-}
 
 
 struct EmittedKernel {

@@ -56,11 +56,8 @@ std::string emit_tape(const Model& model, const LinearEquations& lin, const Gene
     list(t, "reduced-parts", rows);
   }
   if (code.tape.find("kernel sensitivity ") != std::string::npos) {
-    std::vector<std::string> chosen = model.selection().sensitivity_parameters;
-    if (chosen.empty())
-      for (const auto& q : model.parameters()) chosen.push_back(q.name);
     rows.clear();
-    for (const auto& name : chosen) rows.push_back({tape_string(name)});
+    for (const auto& name : sensitivity_parameter_names(model)) rows.push_back({tape_string(name)});
     list(t, "sensitivity-parameters", rows);
   }
   if (code.tape.find("kernel physical ") != std::string::npos) {

@@ -81,43 +81,73 @@ struct TapeKernel {
   bool at_operating_point(const double* v) const;
 };
 
+// One instruction's value, op(a, b) (b unused by unary ops): the kernel's C++ operation.
+inline double apply(std::uint32_t op, double a, double b) {
+  switch (op) {
+    case kMov: return a;
+    case kNeg: return -a;
+    case kAdd: return a + b;
+    case kSub: return a - b;
+    case kMul: return a * b;
+    case kDiv: return a / b;
+    case kSqrt: return std::sqrt(a);
+    case kSin: return std::sin(a);
+    case kCos: return std::cos(a);
+    case kTan: return std::tan(a);
+    case kExp: return std::exp(a);
+    case kLog: return std::log(a);
+    case kFabs: return std::fabs(a);
+    case kAsin: return std::asin(a);
+    case kAcos: return std::acos(a);
+    case kAtan: return std::atan(a);
+    case kSinh: return std::sinh(a);
+    case kCosh: return std::cosh(a);
+    case kTanh: return std::tanh(a);
+    case kAsinh: return std::asinh(a);
+    case kAcosh: return std::acosh(a);
+    case kAtanh: return std::atanh(a);
+    case kAtan2: return std::atan2(a, b);
+    case kPow: return std::pow(a, b);
+  }
+  return 0;
+}
+
 // One instruction's value and derivatives, d ← op(a, b): the value from va, vb, the derivatives
 // along s directions from ta, tb (tb unused by unary ops; td may alias ta or tb, element by
 // element).
 inline double tangent_step(std::uint32_t op, double va, double vb, const double* ta, const double* tb, double* td,
                            std::size_t s) {
-  double vd = 0, da = 0, db = 0;  // vd = op(va, vb); td = da ta + db tb
+  const double vd = apply(op, va, vb);
+  double da = 0, db = 0;  // td = da ta + db tb
   switch (op) {
-    case kMov: vd = va, da = 1; break;
-    case kNeg: vd = -va, da = -1; break;
-    case kAdd: vd = va + vb, da = 1, db = 1; break;
-    case kSub: vd = va - vb, da = 1, db = -1; break;
-    case kMul: vd = va * vb, da = vb, db = va; break;
-    case kDiv: vd = va / vb, da = 1 / vb, db = -vd / vb; break;
-    case kSqrt: vd = std::sqrt(va), da = 0.5 / vd; break;
-    case kSin: vd = std::sin(va), da = std::cos(va); break;
-    case kCos: vd = std::cos(va), da = -std::sin(va); break;
-    case kTan: vd = std::tan(va), da = 1 + vd * vd; break;
-    case kExp: vd = std::exp(va), da = vd; break;
-    case kLog: vd = std::log(va), da = 1 / va; break;
-    case kFabs: vd = std::fabs(va), da = va > 0 ? 1 : va < 0 ? -1 : 0; break;
-    case kAsin: vd = std::asin(va), da = 1 / std::sqrt(1 - va * va); break;
-    case kAcos: vd = std::acos(va), da = -1 / std::sqrt(1 - va * va); break;
-    case kAtan: vd = std::atan(va), da = 1 / (1 + va * va); break;
-    case kSinh: vd = std::sinh(va), da = std::cosh(va); break;
-    case kCosh: vd = std::cosh(va), da = std::sinh(va); break;
-    case kTanh: vd = std::tanh(va), da = 1 - vd * vd; break;
-    case kAsinh: vd = std::asinh(va), da = 1 / std::sqrt(va * va + 1); break;
-    case kAcosh: vd = std::acosh(va), da = 1 / std::sqrt(va * va - 1); break;
-    case kAtanh: vd = std::atanh(va), da = 1 / (1 - va * va); break;
+    case kMov: da = 1; break;
+    case kNeg: da = -1; break;
+    case kAdd: da = 1, db = 1; break;
+    case kSub: da = 1, db = -1; break;
+    case kMul: da = vb, db = va; break;
+    case kDiv: da = 1 / vb, db = -vd / vb; break;
+    case kSqrt: da = 0.5 / vd; break;
+    case kSin: da = std::cos(va); break;
+    case kCos: da = -std::sin(va); break;
+    case kTan: da = 1 + vd * vd; break;
+    case kExp: da = vd; break;
+    case kLog: da = 1 / va; break;
+    case kFabs: da = va > 0 ? 1 : va < 0 ? -1 : 0; break;
+    case kAsin: da = 1 / std::sqrt(1 - va * va); break;
+    case kAcos: da = -1 / std::sqrt(1 - va * va); break;
+    case kAtan: da = 1 / (1 + va * va); break;
+    case kSinh: da = std::cosh(va); break;
+    case kCosh: da = std::sinh(va); break;
+    case kTanh: da = 1 - vd * vd; break;
+    case kAsinh: da = 1 / std::sqrt(va * va + 1); break;
+    case kAcosh: da = 1 / std::sqrt(va * va - 1); break;
+    case kAtanh: da = 1 / (1 - va * va); break;
     case kAtan2: {
-      vd = std::atan2(va, vb);
       const double r2 = va * va + vb * vb;
       da = vb / r2, db = -va / r2;
       break;
     }
     case kPow:
-      vd = std::pow(va, vb);
       da = vb * std::pow(va, vb - 1);
       db = va > 0 ? vd * std::log(va) : 0;  // (the generator's exponents are numbers: tb is 0)
       break;
@@ -166,35 +196,7 @@ int TapeKernel::run(void* const* argv) const {
   for (std::size_t i = 0; i < info.inputs.size(); ++i)
     if (info.inputs[i].second)
       std::memcpy(v + input_offset[i], argv[i], sizeof(double) * info.inputs[i].second);
-  for (const Instruction& c : code) {
-    const double a = v[c.a];
-    switch (c.op) {
-      case kMov: v[c.dst] = a; break;
-      case kNeg: v[c.dst] = -a; break;
-      case kAdd: v[c.dst] = a + v[c.b]; break;
-      case kSub: v[c.dst] = a - v[c.b]; break;
-      case kMul: v[c.dst] = a * v[c.b]; break;
-      case kDiv: v[c.dst] = a / v[c.b]; break;
-      case kSqrt: v[c.dst] = std::sqrt(a); break;
-      case kSin: v[c.dst] = std::sin(a); break;
-      case kCos: v[c.dst] = std::cos(a); break;
-      case kTan: v[c.dst] = std::tan(a); break;
-      case kExp: v[c.dst] = std::exp(a); break;
-      case kLog: v[c.dst] = std::log(a); break;
-      case kFabs: v[c.dst] = std::fabs(a); break;
-      case kAsin: v[c.dst] = std::asin(a); break;
-      case kAcos: v[c.dst] = std::acos(a); break;
-      case kAtan: v[c.dst] = std::atan(a); break;
-      case kSinh: v[c.dst] = std::sinh(a); break;
-      case kCosh: v[c.dst] = std::cosh(a); break;
-      case kTanh: v[c.dst] = std::tanh(a); break;
-      case kAsinh: v[c.dst] = std::asinh(a); break;
-      case kAcosh: v[c.dst] = std::acosh(a); break;
-      case kAtanh: v[c.dst] = std::atanh(a); break;
-      case kAtan2: v[c.dst] = std::atan2(a, v[c.b]); break;
-      case kPow: v[c.dst] = std::pow(a, v[c.b]); break;
-    }
-  }
+  for (const Instruction& c : code) v[c.dst] = apply(c.op, v[c.a], v[c.b]);
   const std::size_t ni = info.inputs.size();
   for (std::size_t o = 0; o < info.outputs.size(); ++o)
     if (fill[o] && info.outputs[o].second)
@@ -274,18 +276,24 @@ struct TapeModel::Impl {
   int operating_point_sensitivity_by_forward_mode(void* const* argv) const;
 };
 
+// The s×s identity, column-major: the directions e_j of the parameters.
+static std::vector<double> identity(std::size_t s) {
+  std::vector<double> e(s * s, 0.0);
+  for (std::size_t j = 0; j < s; ++j) e[j * s + j] = 1;
+  return e;
+}
+
 // sensitivity(y0, yd0, p, dy0, dyd0, dM, dQ, dK, dB, dCy, dCv, dCa, dD, dB1, dB2, dD1): the total
 // derivatives by each parameter p_j of the linear matrices, along (dy0_j, dyd0_j, e_j).
 int TapeModel::Impl::sensitivity_by_forward_mode(void* const* argv) const {
   const std::size_t s = parameters.size();
-  std::vector<double> identity(s * s, 0.0);
-  for (std::size_t j = 0; j < s; ++j) identity[j * s + j] = 1;
+  const std::vector<double> directions = identity(s);
   auto in = [&](std::size_t i) { return static_cast<const double*>(argv[i]); };
   auto out = [&](std::size_t i) { return static_cast<double*>(argv[i]); };
   int status = 0;
   auto along = [&](const TapeKernel* kernel, std::vector<double*> derivatives) {
     const double* values[] = {in(0), in(1), in(2)};
-    const double* seeds[] = {in(3), kernel->info.inputs[1].second ? in(4) : nullptr, identity.data()};
+    const double* seeds[] = {in(3), kernel->info.inputs[1].second ? in(4) : nullptr, directions.data()};
     status = std::max(status, kernel->derivatives(values, seeds, s, derivatives.data()));
   };
   along(known[kLinear], {out(5), out(6), out(7), out(8), out(9), out(10)});
@@ -298,19 +306,18 @@ int TapeModel::Impl::sensitivity_by_forward_mode(void* const* argv) const {
 // parameters; for a static equilibrium dr = ∂r/∂p + Q dyd0 (the caller solves K dy0 = −dr).
 int TapeModel::Impl::operating_point_sensitivity_by_forward_mode(void* const* argv) const {
   const std::size_t s = parameters.size();
-  std::vector<double> identity(s * s, 0.0);
-  for (std::size_t j = 0; j < s; ++j) identity[j * s + j] = 1;
+  const std::vector<double> directions = identity(s);
   const double* p = static_cast<const double*>(argv[2]);
   double* first = static_cast<double*>(argv[3]);
   double* dyd0 = static_cast<double*>(argv[4]);
   const double* values[] = {p};
-  const double* seeds[] = {identity.data()};
+  const double* seeds[] = {directions.data()};
   double* tangents[] = {equilibrium ? nullptr : first, dyd0};
   int status = known[kOperatingPoint]->derivatives(values, seeds, s, tangents);
   if (!equilibrium) return status;
   const std::vector<double> u(inputs.size() + 1, 0.0);
   const double* r_values[] = {static_cast<const double*>(argv[0]), static_cast<const double*>(argv[1]), u.data(), p};
-  const double* r_seeds[] = {nullptr, dyd0, nullptr, identity.data()};
+  const double* r_seeds[] = {nullptr, dyd0, nullptr, directions.data()};
   double* r_tangents[] = {first};
   return std::max(status, known[kResidual]->derivatives(r_values, r_seeds, s, r_tangents));
 }
@@ -531,7 +538,7 @@ class KernelCompiler {
     auto place = [&](std::uint32_t& x) {
       if (x & kConstantTag) x = static_cast<std::uint32_t>(constants_base + (x & kIndexMask));
       else if (x & kScratchTag) x = static_cast<std::uint32_t>(scratch_base + (x & kIndexMask));
-      else if (x >= inputs_) x = x;  // a local: already placed
+      // (an input or a local is placed already)
     };
     for (Instruction& c : k_.code) {
       place(c.dst);

@@ -140,6 +140,9 @@ void write_atomically(const std::filesystem::path& path, const std::string& cont
 /// A double as a C++ literal that round-trips (%.17g, with ".0" added to integers).
 std::string format_double(double v);
 
+/// The parameters of the sensitivity kernel: the scene's, or all, in the model's order.
+std::vector<std::string> sensitivity_parameter_names(const Model& model);
+
 /// A C identifier made from a model name.
 std::string identifier(const std::string& name);
 
