@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <map>
 #include <optional>
-#include <unordered_set>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -22,6 +22,24 @@ using detail::Proof;
 using detail::TreeSize;
 
 namespace {
+
+// Whether test(x) holds for a node x of e, each distinct node tested once. The nodes seen are
+// kept alive, not only their addresses: a sum's or product's operand is often made anew by op()
+// (c·x from the pair (x, c)) and freed after its visit, and a later one at the same address was
+// taken for seen — a result that depended on the allocator, from run to run.
+template <class Test>
+bool any_node(const ex& e, Test&& test) {
+  std::vector<ex> stack{e};
+  std::unordered_map<const GiNaC::basic*, ex> seen;
+  while (!stack.empty()) {
+    const ex x = stack.back();
+    stack.pop_back();
+    if (x.nops() > 0 && !seen.emplace(&GiNaC::ex_to<GiNaC::basic>(x), x).second) continue;
+    if (test(x)) return true;
+    for (std::size_t i = 0; i < x.nops(); ++i) stack.push_back(x.op(i));
+  }
+  return false;
+}
 
 // sin(a), cos(a), tan(a) → s_a, c_a, s_a/c_a, one pair of symbols per argument a.
 struct TrigToSymbols : GiNaC::map_function {
@@ -90,22 +108,13 @@ std::size_t expanded_terms(const ex& e, std::size_t limit) {
 }
 
 // Whether e holds a power that is not a positive integer one (a division or a root), or, with
-// tan_divides, a tangent (which the proof form writes s/c). A subtree shared within e is visited
-// once (its nodes live as long as e does).
+// tan_divides, a tangent (which the proof form writes s/c).
 bool holds_division(const ex& e, bool tan_divides = false) {
-  std::vector<ex> stack{e};
-  std::unordered_set<const GiNaC::basic*> seen;
-  while (!stack.empty()) {
-    const ex x = stack.back();
-    stack.pop_back();
-    if (x.nops() > 0 && !seen.insert(&GiNaC::ex_to<GiNaC::basic>(x)).second) continue;
-    if (isa<GiNaC::power>(x) &&
-        !(isa<GiNaC::numeric>(x.op(1)) && GiNaC::ex_to<GiNaC::numeric>(x.op(1)).is_pos_integer()))
-      return true;
-    if (tan_divides && is_ex_the_function(x, tan)) return true;
-    for (std::size_t i = 0; i < x.nops(); ++i) stack.push_back(x.op(i));
-  }
-  return false;
+  return any_node(e, [tan_divides](const ex& x) {
+    return (isa<GiNaC::power>(x) &&
+            !(isa<GiNaC::numeric>(x.op(1)) && GiNaC::ex_to<GiNaC::numeric>(x.op(1)).is_pos_integer())) ||
+           (tan_divides && is_ex_the_function(x, tan));
+  });
 }
 
 // A written-out candidate with sin, cos and tan of each argument as symbols, when it is within
