@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cache.hpp"
 #include "progress.hpp"
 #include "run.hpp"
 
@@ -129,15 +130,16 @@ int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& sce
 // mbsgen run MODEL [--scene NAME] [-- ARGS...]
 int run_command(int argc, char** argv) {
   const char* usage =
-      "usage: mbsgen run MODEL [--scene NAME] [--compiled] -- info|modes|frf|static|sweep|matrices|simulate|study|outputs "
-      "[ARGS...]\n"
+      "usage: mbsgen run MODEL [--scene NAME] [--compiled] [--debug] -- "
+      "info|modes|frf|static|sweep|matrices|simulate|study|outputs [ARGS...]\n"
       "  generates and caches the model's kernels, then runs the solver with ARGS: info, modes, frf, static,\n"
       "  sweep, matrices and outputs evaluate the kernels from a tape, without a compiler; simulate, study, a\n"
-      "  model with closed loops and --compiled compile and cache the solver first\n"
-      "  (the solver's options: mbsgen run MODEL -- --help)\n";
+      "  model with closed loops and --compiled compile and cache the solver first (--debug: with the\n"
+      "  runtime's debug information, for a debugger)\n"
+      "  (the solver's options: mbsgen run MODEL -- --help; the cache: mbsgen cache --help)\n";
   std::string model_file, scene = "full";
   std::vector<std::string> args;
-  bool compiled = false;
+  bool compiled = false, debug = false;
   int i = 2;
   for (; i < argc; ++i) {
     const std::string a = argv[i];
@@ -151,6 +153,8 @@ int run_command(int argc, char** argv) {
     }
     if (a == "--compiled") {
       compiled = true;
+    } else if (a == "--debug") {
+      debug = true;
     } else if (a == "--scene" && i + 1 < argc) {
       scene = argv[++i];
     } else if (a.rfind("--scene=", 0) == 0) {
@@ -168,7 +172,7 @@ int run_command(int argc, char** argv) {
     return 2;
   }
   try {
-    return mbsgen::tool::run_main(model_file, scene, args, compiled);
+    return mbsgen::tool::run_main(model_file, scene, args, compiled, debug);
   } catch (const mbsgen::ModelError& e) {
     std::cerr << e.what() << "\n";
     return 1;
@@ -226,10 +230,37 @@ int main(int argc, char** argv) try {
       ->check(CLI::Range(std::size_t{0}, std::size_t{10000000}));
   app.add_subcommand("linear", "modes and frequency responses of raw matrices (mbsgen linear --help)");
   app.add_subcommand("run", "generate, compile, cache and run a model's solver (mbsgen run --help)");
+  auto* cache = app.add_subcommand("cache", "list, describe or clean the cache of mbsgen run");
+  cache->require_subcommand(1);
+  auto* cache_list = cache->add_subcommand("list", "every entry: kind, size, last use, model, scene, options");
+  auto* cache_info = cache->add_subcommand("info", "where the cache is, its entries, size and limit");
+  auto* cache_clean = cache->add_subcommand(
+      "clean", "remove entries not in use: all of them, or those chosen by --older-than and --max-size");
+  std::string older_than, max_size;
+  bool dry_run = false;
+  cache_clean->add_option("--older-than", older_than, "entries last used longer ago than this (30d, 12h, 90m, 45s, 2w)");
+  cache_clean->add_option("--max-size", max_size,
+                          "then the least recently used until the cache is within this size (500M, 2G; binary units)");
+  cache_clean->add_flag("--dry-run", dry_run, "say what would be removed, remove nothing");
+  (void)cache_list;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (*cache) {
+    if (*cache_info) return mbsgen::tool::cache_info();
+    if (!*cache_clean) return mbsgen::tool::cache_list();
+    std::optional<double> age;
+    std::optional<std::uintmax_t> size;
+    try {
+      if (!older_than.empty()) age = mbsgen::tool::parse_duration(older_than, "--older-than");
+      if (!max_size.empty()) size = mbsgen::tool::parse_size(max_size, "--max-size");
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "mbsgen cache clean: " << e.what() << "\n";
+      return 2;
+    }
+    return mbsgen::tool::cache_clean(age, size, dry_run);
   }
   if (*generate && !id.empty() && !mbsgen::id_problem(id).empty()) {
     std::cerr << "mbsgen generate: --id '" << id << "' " << mbsgen::id_problem(id) << "\n";

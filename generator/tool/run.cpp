@@ -5,6 +5,7 @@
 // the runtime) rebuilds it. Nothing is written outside the cache.
 #include "run.hpp"
 
+#include "cache.hpp"
 #include "progress.hpp"
 
 #include "mbsgen/generator/codegen/emit.hpp"
@@ -51,35 +52,6 @@ namespace {
 std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ULL) {
   for (unsigned char c : s) h = (h ^ c) * 1099511628211ULL;
   return h;
-}
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + p.string());
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// A directory that only this user can write to, created (mode 0700) if missing: the cache holds
-// programs that `mbsgen run` executes, so one that another user owns or may write is refused.
-void ensure_private_directory(const fs::path& d) {
-  if (!d.parent_path().empty()) fs::create_directories(d.parent_path());
-  if (::mkdir(d.c_str(), 0700) != 0 && errno != EEXIST)
-    throw std::runtime_error("cannot create the solver cache " + d.string() + ": " + std::strerror(errno));
-  struct stat st;
-  if (::lstat(d.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != ::getuid() ||
-      (st.st_mode & S_IWOTH))
-    throw std::runtime_error("the solver cache " + d.string() +
-                             " is not a directory of this user that others cannot write to; "
-                             "set MBSGEN_CACHE_DIR to one");
-}
-
-fs::path cache_root() {
-  if (const char* d = std::getenv("MBSGEN_CACHE_DIR"); d && *d) return d;
-  if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return fs::path(d) / "mbsgen";
-  if (const char* d = std::getenv("HOME"); d && *d) return fs::path(d) / ".cache" / "mbsgen";
-  return fs::temp_directory_path() / ("mbsgen-cache-" + std::to_string(::getuid()));
 }
 
 // Words of a build-configuration string (flags and paths without spaces, as CMake wrote them).
@@ -236,41 +208,6 @@ std::vector<std::size_t> run_jobs(const std::vector<Job>& jobs, std::size_t para
   return failed;
 }
 
-// The record written after a solver, last of a cache entry: its size and FNV-1a hash. It guards
-// against damage (a truncated or deleted solver), not against someone who can write the cache.
-std::string solver_record(const fs::path& solver) {
-  std::ifstream in(solver, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + solver.string());
-  std::uint64_t h = 1469598103934665603ULL;
-  std::size_t size = 0;
-  std::string chunk(1 << 16, '\0');
-  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
-    const auto n = static_cast<std::size_t>(in.gcount());
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ static_cast<unsigned char>(chunk[i])) * 1099511628211ULL;
-    size += n;
-  }
-  char line[80];
-  std::snprintf(line, sizeof line, "size %zu fnv1a64 %016llx\n", size, static_cast<unsigned long long>(h));
-  return line;
-}
-
-// Whether the cache entry dir holds a sound `artifact` (the solver "solve", or the "tape"), with
-// its record `artifact.sum`; why not otherwise.
-bool sound_entry(const fs::path& dir, std::string& why, const std::string& artifact = "solve") {
-  std::error_code ec;
-  if (!fs::exists(dir, ec)) return false;
-  const fs::path file = dir / artifact, record = dir / (artifact + ".sum");
-  const std::string noun = artifact == "solve" ? "solver" : artifact;
-  try {
-    if (!fs::exists(record)) why = "its record " + record.filename().string() + " is missing";
-    else if (!fs::exists(file)) why = "the " + noun + " is missing";
-    else if (read_file(record) != solver_record(file)) why = "the " + noun + " does not match its record";
-  } catch (const std::exception& e) {
-    why = e.what();
-  }
-  return why.empty();
-}
-
 // How many compilers run at once: MBSGEN_JOBS when set (1 to 64), else the number of cores.
 std::size_t parallel_jobs() {
   if (const char* j = std::getenv("MBSGEN_JOBS"); j && *j) {
@@ -321,9 +258,11 @@ std::vector<Job> compile_jobs(const Toolchain& tc, const fs::path& work, const G
 }
 
 // Compiles and links the solver in work; false (with a message naming the log) when the
-// compiler failed.
+// compiler failed. The solver is linked without the runtime libraries' debug information unless
+// `debug` (issue 45: 219 MB of the double pendulum's solver were debug information, 2 MB code); the
+// object files are removed once it is linked.
 bool compile_solver(const Toolchain& tc, const fs::path& work, const GeneratedCode& code, std::size_t parallel,
-                    Progress& progress) {
+                    bool debug, Progress& progress) {
   std::vector<fs::path> objects;
   const std::vector<Job> jobs = compile_jobs(tc, work, code, objects);
   progress.stage("compiling the solver");
@@ -334,6 +273,7 @@ bool compile_solver(const Toolchain& tc, const fs::path& work, const GeneratedCo
     for (const auto& o : objects) link.push_back(o.string());
     link.insert(link.end(), {"-o", (work / "solve").string()});
     link.insert(link.end(), tc.libraries.begin(), tc.libraries.end());
+    if (!debug) link.push_back("-Wl,--strip-debug");
     const fs::path log = work / "link.log";
     int status = 0;
     stop_if_terminated({});
@@ -342,7 +282,11 @@ bool compile_solver(const Toolchain& tc, const fs::path& work, const GeneratedCo
       if (errno != EINTR) return false;
       stop_if_terminated({pid});
     }
-    if (exit_status(status) == 0) return true;
+    if (exit_status(status) == 0) {
+      std::error_code ec;
+      for (const auto& o : objects) fs::remove(o, ec);
+      return true;
+    }
     progress.stop();
     std::cerr << "mbsgen run: error: linking the solver failed; see " << log.string() << "\n";
     return false;
@@ -422,9 +366,11 @@ Emitted emit_model(const std::string& model_file, const std::string& scene, bool
 
 // A private directory (mkdtemp) beside the cache entry dir, filled by fill and renamed to dir
 // when complete, so that neither a concurrent nor an interrupted run leaves a half-built entry;
-// false when fill returned false (nothing is left behind).
+// false when fill returned false (nothing is left behind). The entry is locked (lock) before it
+// is renamed into place, so that no eviction takes it before this run uses it; when another run
+// won the race, its entry stands and lock stays empty.
 template <class Fill>
-bool make_entry(const fs::path& dir, Fill&& fill) {
+bool make_entry(const fs::path& dir, std::optional<EntryLock>& lock, Fill&& fill) {
   std::string name = dir.string() + ".tmp-XXXXXX";
   if (!::mkdtemp(name.data()))
     throw std::runtime_error("cannot create a directory beside " + dir.string() + ": " + std::strerror(errno));
@@ -442,8 +388,12 @@ bool make_entry(const fs::path& dir, Fill&& fill) {
     fs::remove_all(work, ec);
     return false;
   }
+  lock = EntryLock::shared(work);
   fs::rename(work, dir, ec);  // fails if another run won the race: then use its entry
-  if (ec) fs::remove_all(work, ec);
+  if (ec) {
+    lock.reset();
+    fs::remove_all(work, ec);
+  }
   return true;
 }
 
@@ -451,11 +401,11 @@ bool make_entry(const fs::path& dir, Fill&& fill) {
 // Returns false when the compiler failed. The kernels are split into 2 parts per compiler run at
 // once (EmitOptions::parts), compiled in parallel.
 bool build_solver(const std::string& model_file, const std::string& scene, bool dynamics,
-                  const std::optional<std::vector<std::string>>& sensitivity, const std::string& text,
-                  const Toolchain& tc, const fs::path& dir, Progress& progress) {
+                  const std::optional<std::vector<std::string>>& sensitivity, bool debug, const std::string& text,
+                  const Toolchain& tc, const fs::path& dir, std::optional<EntryLock>& lock, Progress& progress) {
   const std::size_t parallel = parallel_jobs();
   const Emitted e = emit_model(model_file, scene, dynamics, sensitivity, 2 * parallel, progress);
-  return make_entry(dir, [&](const fs::path& work) {
+  return make_entry(dir, lock, [&](const fs::path& work) {
     write_generated(e.code, e.api, work.string());
     write_files({{work / "main.cpp",
                   "#include \"model_model.hpp\"\n#include \"mbsgen/runtime/cli/solver_cli.hpp\"\n"
@@ -464,8 +414,15 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
                  // The model's id: the solver's name is `<id>-solve` whatever the file is called,
                  // as the generated code's (issue 39 §3).
                  {work / "id", e.id}});
-    if (!compile_solver(tc, work, e.code, parallel, progress)) return false;
-    write_files({{work / "solve.sum", solver_record(work / "solve")}});  // last: the entry is complete
+    std::string options = dynamics ? "dynamics" : "";
+    if (sensitivity) {
+      options += std::string(options.empty() ? "" : " ") + "sensitivity=";
+      for (std::size_t i = 0; i < sensitivity->size(); ++i) options += (i ? "," : "") + (*sensitivity)[i];
+    }
+    if (debug) options += std::string(options.empty() ? "" : " ") + "debug";
+    describe_entry(work, model_file, scene, "solver", options);
+    if (!compile_solver(tc, work, e.code, parallel, debug, progress)) return false;
+    write_files({{work / "solve.sum", artifact_record(work / "solve")}});  // last: the entry is complete
     return true;
   });
 }
@@ -473,7 +430,7 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
 // Generates the tape of model_file into the cache entry dir (make_entry): the file "tape", empty
 // for a model with closed loops (which only a compiled solver evaluates).
 void build_tape(const std::string& model_file, const std::string& scene, const std::string& text, const fs::path& dir,
-                Progress& progress) {
+                std::optional<EntryLock>& lock, Progress& progress) {
   // A joint or distance constraint closes a loop: known without deriving (rolling contacts may or
   // may not leave a holonomic condition, which only the derivation tells).
   const Model model = apply_scene(read_model_file(model_file), scene);
@@ -481,9 +438,10 @@ void build_tape(const std::string& model_file, const std::string& scene, const s
                                  [](const Constraint& c) { return c.kind != ConstraintKind::rolling; });
   // (The tape's sensitivities come by forward mode, model/tape.hpp: no symbolic kernel is asked for.)
   const Emitted e = loops ? Emitted{} : emit_model(model_file, scene, false, std::nullopt, 0, progress);
-  make_entry(dir, [&](const fs::path& work) {
-    write_files({{work / "tape", e.tape}, {work / "model.yaml", text}});
-    write_files({{work / "tape.sum", solver_record(work / "tape")}});  // last: the entry is complete
+  make_entry(dir, lock, [&](const fs::path& work) {
+    write_files({{work / "tape", e.tape}, {work / "model.yaml", text}, {work / "id", e.id}});
+    describe_entry(work, model_file, scene, "tape", loops ? "closed loops: no tape" : "");
+    write_files({{work / "tape.sum", artifact_record(work / "tape")}});  // last: the entry is complete
     return true;
   });
 }
@@ -554,18 +512,24 @@ fs::path entry_dir(const std::string& key) {
   return root / hex_key(key);
 }
 
-// Makes the cache entry dir hold a sound artifact ("solve", the compiled solver, or "tape"):
-// kept when it does, else reported when damaged and made by build(), which returns 0 or the exit
-// status to end with (returned).
+// Makes the cache entry dir hold a sound artifact ("solve", the compiled solver, or "tape"),
+// locked (cache.hpp: held until the program this process becomes ends) and marked as used: kept
+// when it is sound, else reported when damaged and made by build(), which returns 0 or the exit
+// status to end with (returned). After a build the cache is brought within its limit.
 template <class Build>
-int ensure_entry(const fs::path& dir, const std::string& artifact, const std::string& model_file, Build&& build) {
+int ensure_entry(const fs::path& dir, const std::string& artifact, const std::string& model_file,
+                 std::optional<EntryLock>& lock, Build&& build) {
   const std::string noun = artifact == "solve" ? "solver" : artifact;
   std::string why;
-  if (sound_entry(dir, why, artifact)) return 0;
+  lock = EntryLock::shared(dir);
+  if (lock && sound_artifact(dir, artifact, why)) {
+    touch_entry(dir);
+    return 0;
+  }
+  lock.reset();
   if (!why.empty()) {
     std::cerr << "mbsgen run: the cached " << noun << " " << dir.string() << " is damaged (" << why << "): rebuilding it\n";
-    std::error_code ec;
-    fs::remove_all(dir, ec);
+    discard_entry(dir);
   }
   const auto t0 = std::chrono::steady_clock::now();
   if (const int status = build()) return status;
@@ -574,8 +538,12 @@ int ensure_entry(const fs::path& dir, const std::string& artifact, const std::st
     std::cerr << "mbsgen run: " << (artifact == "solve" ? "built" : "generated") << " the " << noun << " of "
               << model_file << " in " << std::setprecision(3) << seconds << " s\n";
   why.clear();
-  if (!sound_entry(dir, why, artifact))
-    throw std::runtime_error("the " + noun + " just made in " + dir.string() + " is not sound (" + why + ")");
+  // Locked from its birth (make_entry), or another run's entry that won the race.
+  if (!lock) lock = EntryLock::shared(dir);
+  if (!lock || !sound_artifact(dir, artifact, why))
+    throw std::runtime_error("the " + noun + " just made in " + dir.string() + " is not sound (" +
+                             (why.empty() ? "it was removed meanwhile" : why) + ")");
+  enforce_cache_limit(dir);
   return 0;
 }
 
@@ -597,9 +565,10 @@ int exec_program(const fs::path& program, std::string name, std::vector<std::str
 std::optional<int> run_tape(const std::string& model_file, const std::string& scene, std::vector<std::string>& args,
                             const std::string& text) {
   const fs::path dir = entry_dir(text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + "tape" + exe_identity());
-  if (const int status = ensure_entry(dir, "tape", model_file, [&] {
+  std::optional<EntryLock> lock;
+  if (const int status = ensure_entry(dir, "tape", model_file, lock, [&] {
         Progress progress("run");
-        build_tape(model_file, scene, text, dir, progress);
+        build_tape(model_file, scene, text, dir, lock, progress);
         return 0;
       }))
     return status;
@@ -614,13 +583,15 @@ std::optional<int> run_tape(const std::string& model_file, const std::string& sc
 }  // namespace
 #endif  // MBSGEN_RUN_AVAILABLE
 
-int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args, bool compiled) {
+int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args, bool compiled,
+             bool debug) {
 #ifndef MBSGEN_RUN_AVAILABLE
-  (void)model_file, (void)scene, (void)args, (void)compiled;
+  (void)model_file, (void)scene, (void)args, (void)compiled, (void)debug;
   std::cerr << "mbsgen run: this mbsgen was built without the runtime (MBSGEN_BUILD_RUNTIME=OFF)\n";
   return 1;
 #else
   const std::string text = read_model_text(model_file);  // throws: reported by the caller, exit 1
+  cache_limit();  // a malformed MBSGEN_CACHE_MAX_SIZE is reported before any work
   const std::optional<std::vector<std::string>> sensitivity = sensitivity_request(scene, args);
   if (sensitivity && !sensitivity->empty()) {  // an unknown name is a usage error, as the solver's
     try {
@@ -633,7 +604,7 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   // The tape answers a one-off analysis; a compiled solver what runs the kernels many times
   // (simulate, study) and what is asked for with --compiled.
   const bool many_calls = !args.empty() && (args[0] == "simulate" || args[0] == "study");
-  if (!compiled && !many_calls) {
+  if (!compiled && !debug && !many_calls) {
     if (const std::optional<int> status = run_tape(model_file, scene, args, text)) return *status;
   }
   const Toolchain tc = toolchain();
@@ -642,6 +613,7 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   const bool dynamics = !args.empty() && args[0] == "simulate" && scene == "full";
   std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
   if (dynamics) key += std::string(1, '\0') + "dynamics";
+  if (debug) key += std::string(1, '\0') + "debug";
   if (sensitivity) {
     key += std::string(1, '\0') + "sensitivity";
     for (const auto& name : *sensitivity) key += ',' + name;
@@ -659,11 +631,12 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   }
   key += '\0' + std::string("/proc/self/exe") + exe_identity();
   const fs::path dir = entry_dir(key);
-  if (const int status = ensure_entry(dir, "solve", model_file, [&] {
+  std::optional<EntryLock> lock;
+  if (const int status = ensure_entry(dir, "solve", model_file, lock, [&] {
         try {
           TerminationGuard guard;
           Progress progress("run");  // on a terminal, after 2 s: the stage, and files compiled
-          return build_solver(model_file, scene, dynamics, sensitivity, text, tc, dir, progress) ? 0 : 1;
+          return build_solver(model_file, scene, dynamics, sensitivity, debug, text, tc, dir, lock, progress) ? 0 : 1;
         } catch (const Terminated& t) {  // the children stopped, the build directory removed
           std::cerr << "mbsgen run: " << t.what() << "; the solver was not built\n";
           return 128 + t.signal;

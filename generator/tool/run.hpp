@@ -10,9 +10,10 @@ namespace mbsgen::tool {
 /// simulate and study, a model with closed loops, or when `compiled`, on its cached compiled
 /// solver (building either first if needed); returns the exit code (or does not return: the
 /// compiled solver replaces this process). Throws ModelError for a bad model, std::exception for
-/// other failures.
+/// other failures. debug: a compiled solver with the runtime's debug information (a cache entry
+/// of its own; without it the solver is linked without).
 int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args,
-             bool compiled = false);
+             bool compiled = false, bool debug = false);
 
 /// A T made by make() and never destroyed. The derivation of a large model is millions of GiNaC
 /// nodes, and freeing them one by one took 5 % of a 40-link chain's generation; the process's
