@@ -7,6 +7,7 @@
 
 #include "cache.hpp"
 #include "progress.hpp"
+#include "run_key.hpp"
 
 #include "mbsgen/generator/codegen/emit.hpp"
 #include "mbsgen/generator/codegen/emit_api.hpp"
@@ -48,48 +49,6 @@ namespace fs = std::filesystem;
 
 #ifdef MBSGEN_RUN_AVAILABLE
 namespace {
-
-std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ULL) {
-  for (unsigned char c : s) h = (h ^ c) * 1099511628211ULL;
-  return h;
-}
-
-// Words of a build-configuration string (flags and paths without spaces, as CMake wrote them).
-std::vector<std::string> words(const std::string& s) {
-  std::vector<std::string> out;
-  std::istringstream in(s);
-  for (std::string w; in >> w;) out.push_back(w);
-  return out;
-}
-
-// The compiler and where the runtime's headers and libraries are: beside an installed mbsgen
-// (<prefix>/bin, <prefix>/lib, <prefix>/include), otherwise in the build tree it was built in.
-// Each entry is one argument of the compiler: nothing passes through a shell.
-struct Toolchain {
-  std::string compiler;
-  std::vector<std::string> includes, libraries;
-};
-
-Toolchain toolchain() {
-  Toolchain t;
-  t.compiler = MBSGEN_CXX_COMPILER;
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  const fs::path prefix = ec ? fs::path() : exe.parent_path().parent_path();
-  const fs::path installed_solver = prefix / MBSGEN_INSTALL_LIBDIR / MBSGEN_SOLVER_LIBRARY_NAME;
-  if (!prefix.empty() && fs::exists(installed_solver) &&
-      fs::exists(prefix / "include/mbsgen/runtime/cli/solver_cli.hpp")) {
-    t.includes = {"-I" + (prefix / "include").string()};
-    t.libraries = {installed_solver.string(),
-                   (prefix / MBSGEN_INSTALL_LIBDIR / MBSGEN_RUNTIME_LIBRARY_NAME).string()};
-  } else {
-    t.includes = {std::string("-I") + MBSGEN_BUILD_RUNTIME_INCLUDE};
-    t.libraries = {MBSGEN_BUILD_SOLVER_LIBRARY, MBSGEN_BUILD_RUNTIME_LIBRARY};
-  }
-  for (auto& w : words(MBSGEN_EXTRA_INCLUDES)) t.includes.push_back(w);
-  for (auto& w : words(MBSGEN_EXTRA_LIBRARIES)) t.libraries.push_back(w);
-  return t;
-}
 
 // Starts argv[0] (searched on PATH when it has no '/') with argv, its standard output and error
 // going to log (created exclusively); returns its process id. The child leads a process group of
@@ -446,64 +405,11 @@ void build_tape(const std::string& model_file, const std::string& scene, const s
   });
 }
 
-// `modes|frf --sensitivity [NAME,…]` of the full model: the parameters asked for (empty: all),
-// for a solver with the sensitivity kernel by exactly those (issue 40 §2: made only when asked, and
-// cached as its own entry); nullopt when no sensitivity is asked for, or for a scene (whose
-// analyses say whether it has them).
-std::optional<std::vector<std::string>> sensitivity_request(const std::string& scene, const std::vector<std::string>& args) {
-  if (scene != kFullScene || args.empty() || (args[0] != "modes" && args[0] != "frf")) return std::nullopt;
-  for (std::size_t i = 1; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a != "--sensitivity" && a.rfind("--sensitivity=", 0) != 0) continue;
-    std::vector<std::string> names;
-    auto add = [&names](const std::string& text) {
-      std::stringstream list(text);
-      for (std::string name; std::getline(list, name, ',');)
-        if (!name.empty()) names.push_back(name);
-    };
-    if (a.size() > 13) add(a.substr(14));
-    else
-      for (std::size_t j = i + 1; j < args.size() && (args[j].empty() || args[j][0] != '-'); ++j) add(args[j]);
-    std::sort(names.begin(), names.end());  // one cache entry per set of parameters
-    names.erase(std::unique(names.begin(), names.end()), names.end());
-    return names;
-  }
-  return std::nullopt;
-}
-
 }  // namespace
 #endif  // MBSGEN_RUN_AVAILABLE
 
 #ifdef MBSGEN_RUN_AVAILABLE
 namespace {
-
-// The key's part that names this generator: its file's size and time of modification (a
-// generator rebuilt in place makes new entries).
-std::string exe_identity() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  std::string key = std::string(1, '\0') + self.string();
-  const auto size = fs::file_size(self, ec);
-  const auto time = fs::last_write_time(self, ec);
-  if (!ec) key += '\0' + std::to_string(size) + '\0' + std::to_string(time.time_since_epoch().count());
-  return key;
-}
-
-std::string hex_key(const std::string& key) {
-  char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(key)));
-  return hash;
-}
-
-// The model's id from a cache entry (an entry written before ids were recorded: the file's stem).
-std::string entry_id(const fs::path& dir, const std::string& model_file) {
-  std::string id = fs::path(model_file).stem().string();
-  if (std::error_code ec; fs::is_regular_file(dir / "id", ec)) {
-    const std::string recorded = read_file(dir / "id");
-    if (!recorded.empty() && recorded.size() < 256) id = recorded;
-  }
-  return id;
-}
 
 // The cache entry of key: a private directory of the cache, by the key's hash.
 fs::path entry_dir(const std::string& key) {
@@ -564,7 +470,7 @@ int exec_program(const fs::path& program, std::string name, std::vector<std::str
 // nullopt when the model has no tape (closed loops): then a compiled solver answers.
 std::optional<int> run_tape(const std::string& model_file, const std::string& scene, std::vector<std::string>& args,
                             const std::string& text) {
-  const fs::path dir = entry_dir(text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + "tape" + exe_identity());
+  const fs::path dir = entry_dir(tape_key(text, scene));
   std::optional<EntryLock> lock;
   if (const int status = ensure_entry(dir, "tape", model_file, lock, [&] {
         Progress progress("run");
@@ -574,9 +480,7 @@ std::optional<int> run_tape(const std::string& model_file, const std::string& sc
     return status;
   std::error_code ec;
   if (fs::file_size(dir / "tape", ec) == 0 && !ec) return std::nullopt;  // closed loops
-  // mbsgen-tape beside this mbsgen (installed), else the one of its build tree.
-  fs::path solver = fs::read_symlink("/proc/self/exe", ec).parent_path() / MBSGEN_TAPE_SOLVER_NAME;
-  if (!fs::is_regular_file(solver, ec)) solver = MBSGEN_BUILD_TAPE_SOLVER;
+  const fs::path solver = tape_solver();
   return exec_program(solver, solver.string(), {(dir / "tape").string()}, args);
 }
 
@@ -611,26 +515,7 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
   // `simulate` needs the kernels of a time step (EmitOptions::dynamics: the dynamics Jacobian);
   // the other commands' solver is built without them, as they cost compile time.
   const bool dynamics = !args.empty() && args[0] == "simulate" && scene == "full";
-  std::string key = text + '\0' + scene + '\0' + kGeneratorVersion + '\0' + tc.compiler;
-  if (dynamics) key += std::string(1, '\0') + "dynamics";
-  if (debug) key += std::string(1, '\0') + "debug";
-  if (sensitivity) {
-    key += std::string(1, '\0') + "sensitivity";
-    for (const auto& name : *sensitivity) key += ',' + name;
-  }
-  for (const auto& a : tc.includes) key += '\0' + a;
-  // A library or generator rebuilt in place (a developer's build tree) makes a new key: their size
-  // and time of modification are part of it, so a solver is never linked against an older runtime
-  // nor built from kernels an older generator wrote.
-  for (const auto& a : tc.libraries) {
-    key += '\0' + a;
-    std::error_code ec;
-    const auto size = fs::file_size(a, ec);
-    const auto time = fs::last_write_time(a, ec);
-    if (!ec) key += '\0' + std::to_string(size) + '\0' + std::to_string(time.time_since_epoch().count());
-  }
-  key += '\0' + std::string("/proc/self/exe") + exe_identity();
-  const fs::path dir = entry_dir(key);
+  const fs::path dir = entry_dir(solver_key(text, scene, dynamics, debug, sensitivity, tc));
   std::optional<EntryLock> lock;
   if (const int status = ensure_entry(dir, "solve", model_file, lock, [&] {
         try {

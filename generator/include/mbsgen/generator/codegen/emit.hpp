@@ -8,6 +8,7 @@
 #include "mbsgen/generator/codegen/output_files.hpp"
 #include "mbsgen/generator/linear/linearize.hpp"
 #include "mbsgen/generator/model/scene.hpp"
+#include "mbsgen/generator/codegen/version.hpp"
 
 #include <filesystem>
 #include <memory>
@@ -17,7 +18,6 @@
 namespace mbsgen {
 
 inline constexpr int kAbiVersion = 1;
-inline constexpr const char* kGeneratorVersion = "0.1.0";
 
 struct EmitOptions {
   bool cse = true;
