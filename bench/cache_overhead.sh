@@ -20,11 +20,11 @@ while read -r id model scene flags; do
   models+=("$model")
 done < generated/models.txt
 
-# median_pair A_COMMAND... -- B_COMMAND...: "A_ms B_ms (A-B)_ms" as medians over the pairs.
+# median_pair A_COMMAND... :: B_COMMAND...: "A_ms B_ms (A-B)_ms" as medians over the pairs.
 median_pair() {
   /usr/bin/python3 - "$runs" "$@" <<'EOF'
 import statistics, subprocess, sys, time
-runs = int(sys.argv[1]); args = sys.argv[2:]; cut = args.index('--')
+runs = int(sys.argv[1]); args = sys.argv[2:]; cut = args.index('::')
 a, b = args[:cut], args[cut + 1:]
 def once(cmd):
     t = time.perf_counter()
@@ -47,13 +47,13 @@ for model in "${models[@]}"; do
   "$mbsgen" run "$model" -- modes >/dev/null 2>&1
   tape=$(ls "$cache"/*/tape)
   if [[ -s "$tape" ]]; then
-    read -r rt dt ot < <(median_pair "$mbsgen" run "$model" -- modes -- "$tape_solver" "$tape" modes)
+    read -r rt dt ot < <(median_pair "$mbsgen" run "$model" -- modes :: "$tape_solver" "$tape" modes)
   else
     rt=- dt=- ot=-  # closed loops: no tape
   fi
   "$mbsgen" run "$model" --compiled -- modes >/dev/null 2>&1
   solve=$(ls "$cache"/*/solve)
-  read -r rc dc oc < <(median_pair "$mbsgen" run "$model" --compiled -- modes -- "$solve" modes)
+  read -r rc dc oc < <(median_pair "$mbsgen" run "$model" --compiled -- modes :: "$solve" modes)
   size=$(stat -c %s "$solve")
   printf '%-46s %8s %8s %8s | %9s %8s %8s %9.1f\n' "$model" "$rt" "$dt" "$ot" "$rc" "$dc" "$oc" \
     "$(echo "$size / 1048576" | bc -l)"
