@@ -4,7 +4,10 @@
 # the wall time, the compile and link time summed per directory of the tree, and the heaviest
 # translation units and links.
 #
-#   bench/build_times.sh [--preset dev|ci|asan] [--target T] [--jobs N] [--dir DIR]
+#   bench/build_times.sh [--preset dev|ci|asan|demo] [--target T] [--jobs N] [--dir DIR] [-DVAR=VALUE ...]
+#
+# -D options go to the configuration (-DCMAKE_DISABLE_PRECOMPILE_HEADERS=ON: without precompiled
+# headers, for a comparison).
 #
 # Defaults: preset dev, target all, 2 jobs, build directory build/times-<preset>. Nothing else
 # is touched; the raw times stay in DIR/times.tsv.
@@ -14,12 +17,14 @@ preset=dev
 target=all
 jobs=2
 dir=""
+defines=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --preset) preset="$2"; shift ;;
     --target) target="$2"; shift ;;
     --jobs) jobs="$2"; shift ;;
     --dir) dir="$2"; shift ;;
+    -D*) defines+=("$1") ;;
     *) echo "usage: bench/build_times.sh [--preset P] [--target T] [--jobs N] [--dir DIR]" >&2; exit 2 ;;
   esac
   shift
@@ -28,13 +33,13 @@ dir=${dir:-build/times-$preset}
 rm -rf "$dir"
 launcher="$PWD/bench/time_step.sh"
 cmake --preset "$preset" -B "$dir" -DCMAKE_CXX_COMPILER_LAUNCHER="$launcher" \
-  -DCMAKE_CXX_LINKER_LAUNCHER="$launcher" > /dev/null
+  -DCMAKE_CXX_LINKER_LAUNCHER="$launcher" "${defines[@]}" > /dev/null
 export MBSGEN_BUILD_TIMES="$PWD/$dir/times.tsv"
 : > "$MBSGEN_BUILD_TIMES"
 start=$(date +%s)
 cmake --build "$dir" -j "$jobs" --target "$target" > "$dir/build.log" 2>&1 || { tail -30 "$dir/build.log"; exit 1; }
 wall=$(( $(date +%s) - start ))
-echo "preset $preset, target $target, -j $jobs: wall $wall s"
+echo "preset $preset ${defines[*]}, target $target, -j $jobs: wall $wall s"
 awk -F'\t' '
   { out = $3
     target = "(other)"

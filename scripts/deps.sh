@@ -2,22 +2,52 @@
 # Installs the Debian packages mbsgen needs, if any is missing, plus any packages named as
 # arguments (scripts/fuzz.sh adds clang and libclang-rt-14-dev; the test suite needs neither).
 # As root: apt-get update, then apt-get install. Otherwise: prints the command and exits 1.
+#
+# SUNDIALS (CVODE, for simulate): the runtime library libsundials-cvode6 only, which holds CVODE
+# with the serial vector and the dense matrix and solver mbsgen uses. Debian's libsundials-dev,
+# the only package with the headers, depends on PETSc, HYPRE, MUMPS, Trilinos, HDF5 and gfortran
+# (134 packages, 399 MB installed, on Debian 12); its headers are taken from its .deb instead
+# (apt-get download, no root needed), into build/deps/sundials, where CMake finds them when
+# /usr/include has none (docs/building.md, "Dependencies").
 set -euo pipefail
+cd "$(dirname "$0")/.."
 packages=(cmake g++ make pkg-config libginac-dev libcln-dev libeigen3-dev libyaml-cpp-dev
           libcli11-dev libgtest-dev liblapacke-dev libopenblas-dev gnuplot-nox libjemalloc-dev
-          libsundials-dev libboost-dev libopenmpi-dev openmpi-bin "$@")
+          libsundials-cvode6 libboost-dev libopenmpi-dev openmpi-bin "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
-cmd="apt-get update && apt-get install -y --no-install-recommends ${missing[*]}"
-if [ "$(id -u)" -ne 0 ]; then
-  echo "mbsgen: missing Debian packages: ${missing[*]}" >&2
-  echo "run as root:  $cmd" >&2
-  exit 1
+if [ ${#missing[@]} -gt 0 ]; then
+  cmd="apt-get update && apt-get install -y --no-install-recommends ${missing[*]}"
+  if [ "$(id -u)" -ne 0 ]; then
+    echo "mbsgen: missing Debian packages: ${missing[*]}" >&2
+    echo "run as root:  $cmd" >&2
+    exit 1
+  fi
+  echo "mbsgen: installing ${missing[*]}" >&2
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-echo "mbsgen: installing ${missing[*]}" >&2
-export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq
-apt-get install -y -qq --no-install-recommends "${missing[@]}"
+
+# The SUNDIALS headers of the installed library's version, unless libsundials-dev is installed.
+headers=build/deps/sundials
+version=$(dpkg-query -W -f='${Version}' libsundials-cvode6)
+if [ ! -f /usr/include/cvode/cvode.h ] && [ "$(cat "$headers/version" 2>/dev/null)" != "$version" ]; then
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+  download() { (cd "$work" && apt-get download -qq "libsundials-dev=$version" > log 2>&1); }
+  if ! download && ! { [ "$(id -u)" -eq 0 ] && apt-get update -qq && download; }; then
+    cat "$work/log" >&2
+    echo "mbsgen: cannot download libsundials-dev=$version for its headers (run apt-get update, or install" \
+         "libsundials-dev)" >&2
+    exit 1
+  fi
+  dpkg-deb -x "$work"/libsundials-dev_*.deb "$work/root"
+  rm -rf "$headers"
+  mkdir -p "$headers"
+  cp -r "$work/root/usr/include" "$headers/include"
+  echo "$version" > "$headers/version"
+  echo "mbsgen: SUNDIALS $version headers from libsundials-dev's package in $headers" >&2
+fi

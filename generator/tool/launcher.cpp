@@ -62,25 +62,13 @@ bool cached(const fs::path& dir, const std::string& artifact, std::optional<Entr
 // `mbsgen run MODEL [--scene NAME] [--compiled] [--debug] -- ARGS` answered by the cached tape or
 // solver, as mbsgen-core would choose and find it; returns when it cannot.
 void run_cached(int argc, char** argv) {
-  std::string model_file, scene = "full";
-  bool compiled = false, debug = false;
-  int i = 2;
-  for (; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--") {
-      ++i;
-      break;
-    }
-    if (a == "--compiled") compiled = true;
-    else if (a == "--debug") debug = true;
-    else if (a == "--scene" && i + 1 < argc) scene = argv[++i];
-    else if (a.rfind("--scene=", 0) == 0) scene = a.substr(8);
-    else if (!a.empty() && a[0] != '-' && model_file.empty()) model_file = a;
-    else return;  // help, or a usage error: mbsgen-core's
-  }
-  std::vector<std::string> args(argv + i, argv + argc);
+  const mbsgen::tool::RunRequest r = mbsgen::tool::parse_run(argc, argv);
+  if (r.help || !r.error.empty()) return;  // mbsgen-core's
+  const std::string& scene = r.scene;
+  const std::vector<std::string>& args = r.args;
+  const bool compiled = r.compiled, debug = r.debug;
   std::string text;
-  if (model_file.empty() || mbsgen::tool::sensitivity_request(scene, args) || !read_regular(model_file, text)) return;
+  if (mbsgen::tool::sensitivity_request(scene, args) || !read_regular(r.model_file, text)) return;
   fs::path root;
   try {
     mbsgen::tool::cache_limit();  // a malformed limit is reported by mbsgen-core
@@ -109,7 +97,7 @@ void run_cached(int argc, char** argv) {
   const fs::path dir = root / mbsgen::tool::hex_key(mbsgen::tool::solver_key(text, scene, dynamics, debug, std::nullopt,
                                                                              mbsgen::tool::toolchain()));
   if (!cached(dir, "solve", lock)) return;
-  std::vector<std::string> v = {mbsgen::tool::entry_id(dir, model_file) + "-solve"};
+  std::vector<std::string> v = {mbsgen::tool::entry_id(dir, r.model_file) + "-solve"};
   v.insert(v.end(), args.begin(), args.end());
   exec_with(dir / "solve", v);
 }

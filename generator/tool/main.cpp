@@ -13,6 +13,7 @@
 #include "cache.hpp"
 #include "progress.hpp"
 #include "run.hpp"
+#include "run_key.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -137,42 +138,17 @@ int run_command(int argc, char** argv) {
       "  model with closed loops and --compiled compile and cache the solver first (--debug: with the\n"
       "  runtime's debug information, for a debugger)\n"
       "  (the solver's options: mbsgen run MODEL -- --help; the cache: mbsgen cache --help)\n";
-  std::string model_file, scene = "full";
-  std::vector<std::string> args;
-  bool compiled = false, debug = false;
-  int i = 2;
-  for (; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--") {
-      ++i;
-      break;
-    }
-    if (a == "-h" || a == "--help") {
-      std::cout << usage;
-      return 0;
-    }
-    if (a == "--compiled") {
-      compiled = true;
-    } else if (a == "--debug") {
-      debug = true;
-    } else if (a == "--scene" && i + 1 < argc) {
-      scene = argv[++i];
-    } else if (a.rfind("--scene=", 0) == 0) {
-      scene = a.substr(8);
-    } else if (!a.empty() && a[0] != '-' && model_file.empty()) {
-      model_file = a;
-    } else {
-      std::cerr << "mbsgen run: unexpected argument '" << a << "'\n" << usage;
-      return 2;
-    }
+  const mbsgen::tool::RunRequest r = mbsgen::tool::parse_run(argc, argv);
+  if (r.help) {
+    std::cout << usage;
+    return 0;
   }
-  for (; i < argc; ++i) args.emplace_back(argv[i]);
-  if (model_file.empty()) {
-    std::cerr << "mbsgen run: missing MODEL\n" << usage;
+  if (!r.error.empty()) {
+    std::cerr << "mbsgen run: " << r.error << "\n" << usage;
     return 2;
   }
   try {
-    return mbsgen::tool::run_main(model_file, scene, args, compiled, debug);
+    return mbsgen::tool::run_main(r.model_file, r.scene, r.args, r.compiled, r.debug);
   } catch (const mbsgen::ModelError& e) {
     std::cerr << e.what() << "\n";
     return 1;

@@ -76,6 +76,39 @@ fs::path tape_solver() {
 }
 #endif
 
+RunRequest parse_run(int argc, char** argv) {
+  RunRequest r;
+  int i = 2;
+  for (; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--") {
+      ++i;
+      break;
+    }
+    if (a == "-h" || a == "--help") {
+      r.help = true;
+      return r;
+    }
+    if (a == "--compiled") {
+      r.compiled = true;
+    } else if (a == "--debug") {
+      r.debug = true;
+    } else if (a == "--scene" && i + 1 < argc) {
+      r.scene = argv[++i];
+    } else if (a.rfind("--scene=", 0) == 0) {
+      r.scene = a.substr(8);
+    } else if (!a.empty() && a[0] != '-' && r.model_file.empty()) {
+      r.model_file = a;
+    } else {
+      r.error = "unexpected argument '" + a + "'";
+      return r;
+    }
+  }
+  r.args.assign(argv + i, argv + argc);
+  if (r.model_file.empty()) r.error = "missing MODEL";
+  return r;
+}
+
 fs::path core_program() { return running_program().parent_path() / "mbsgen-core"; }
 
 std::optional<std::vector<std::string>> sensitivity_request(const std::string& scene,

@@ -23,6 +23,15 @@ struct Toolchain {
 };
 Toolchain toolchain();
 
+/// `mbsgen run MODEL [--scene NAME] [--compiled] [--debug] [-- ARGS...]` (argv[1] is "run").
+struct RunRequest {
+  std::string model_file, scene = "full";
+  bool compiled = false, debug = false, help = false;
+  std::vector<std::string> args;  // the solver's
+  std::string error;              // a usage error, when not empty
+};
+RunRequest parse_run(int argc, char** argv);
+
 /// The program that generates and builds (mbsgen-core), beside the running one.
 fs::path core_program();
 /// The generic tape solver: mbsgen-tape beside the running program (installed), else the one of

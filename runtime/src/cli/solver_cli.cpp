@@ -23,7 +23,9 @@
 #include "cli/cli_output.hpp"
 #include "cli/outputs_cli.hpp"
 #include "cli/sensitivity_cli.hpp"
+#ifdef MBSGEN_WITH_SIMULATION
 #include "cli/simulate_cli.hpp"
+#endif
 #include "cli/study_cli.hpp"
 #include "mbsgen/runtime/spectral/descriptor_eigen.hpp"
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
@@ -521,8 +523,13 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   matrices->add_option("--format", o.format, "json (standard output) or mtx (files in --out)")
       ->check(CLI::IsMember({"json", "mtx"}));
   matrices->add_option("--out", o.out_dir, "directory of the .mtx files (default: current)");
+#ifdef MBSGEN_WITH_SIMULATION
   SimulateOptions simulate_options;
   CLI::App* simulate = add_simulate(app, simulate_options);
+#else  // a solver of a build without simulation (MBSGEN_WITH_SIMULATION=OFF: the demo's)
+  CLI::App* simulate = app.add_subcommand("simulate", "time simulation: not in this build (MBSGEN_WITH_SIMULATION=OFF)");
+  simulate->allow_extras();
+#endif
   StudyOptions study_options;
   CLI::App* study = add_study(app, study_options);
   OutputsOptions outputs_options;
@@ -541,7 +548,11 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     err << program << ": " << e.what() << "\nRun with --help for more information.\n";
     return 2;
   }
+#ifdef MBSGEN_WITH_SIMULATION
   for (const auto* sets : {&o.set, &simulate_options.set, &study_options.set, &outputs_options.set}) {
+#else
+  for (const auto* sets : {&o.set, &study_options.set, &outputs_options.set}) {
+#endif
     const std::string problem = set_value_problem(*sets);
     if (!problem.empty()) {
       err << program << ": " << problem << "\nRun with --help for more information.\n";
@@ -566,7 +577,14 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
     if (frf->parsed()) return run_frf(k, o, out, err);
     if (stat->parsed()) return run_static(k, o, out);
     if (sweep->parsed()) return run_sweep(k, o, out, err);
+#ifdef MBSGEN_WITH_SIMULATION
     if (simulate->parsed()) return run_simulate(k, simulate_options, out, err);
+#else
+    if (simulate->parsed()) {
+      err << program << ": simulate: this solver was built without simulation (MBSGEN_WITH_SIMULATION=OFF)\n";
+      return 1;
+    }
+#endif
     if (study->parsed()) return run_study(k, study_options, out, err);
     if (outputs->parsed()) return run_outputs(k, outputs_options, out);
     return run_matrices(k, o, out, err);
