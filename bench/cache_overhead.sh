@@ -13,12 +13,7 @@ tape_solver=$(realpath "$2")
 runs=${3:-21}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-models=()
-while read -r id model scene flags; do
-  [[ -z "$id" || "$id" == \#* || "$scene" != full ]] && continue
-  [[ " ${models[*]} " == *" $model "* ]] && continue
-  models+=("$model")
-done < generated/models.txt
+source bench/shipped_models.sh
 
 # median_pair A_COMMAND... :: B_COMMAND...: "A_ms B_ms (A-B)_ms" as medians over the pairs.
 median_pair() {

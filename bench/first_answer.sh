@@ -12,12 +12,7 @@ mbsgen=$1
 shift
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-models=()
-while read -r id model scene flags; do
-  [[ -z "$id" || "$id" == \#* || "$scene" != full ]] && continue
-  [[ " ${models[*]} " == *" $model "* ]] && continue
-  models+=("$model")
-done < generated/models.txt
+source bench/shipped_models.sh
 models+=("$@")
 timed() {  # cache, then the run's arguments: prints "seconds peak_MB"
   local cache=$1
