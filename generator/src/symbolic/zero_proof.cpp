@@ -61,14 +61,100 @@ struct TrigToSymbols : GiNaC::map_function {
   }
 };
 
-// A polynomial in c_a of degree ≤ 1 for every argument a, using c² = 1 − s².
-ex reduce_pythagoras(ex e, const TrigToSymbols& trig) {
+// Radicals as symbols: every power B^(p/q) with a rational, non-integer exponent becomes t^(p·Q/q),
+// one symbol t = B^(1/Q) per base B (keyed by B expanded: (x − y)² and (y − x)² are one base) with
+// Q the least common multiple of the denominators of B's exponents; a radical inside a base first.
+// What makes the verdict independent of how GiNaC wrote the expression: left to normal(), B^(1/2)
+// and B^(3/2) were two unrelated symbols, and whether a product such as B·B^(−3/2) had been
+// combined into B^(−1/2) before (it depends on operand order, which follows hashes seeded by
+// addresses) decided the proof. Only t^Q = B is used (reduce_radicals), never t = a root of B that
+// holds for some values only (√(x²) is |x|, not x): sound, for every branch of the root.
+class RadicalsToSymbols {
+ public:
+  struct Root {
+    GiNaC::symbol t;
+    GiNaC::numeric Q = 1;
+    ex base;  // B with its own radicals as symbols, expanded (once replace() has run)
+    bool has_base = false;
+  };
+
+  ex replace(const ex& e) {
+    collect(e);
+    return rewrite(e);
+  }
+  const std::vector<Root>& roots() const { return roots_; }
+
+ private:
+  static bool is_radical(const ex& e) {
+    return isa<GiNaC::power>(e) && isa<GiNaC::numeric>(e.op(1)) &&
+           GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_rational() && !GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer();
+  }
+  void collect(const ex& e) {
+    any_node(e, [this](const ex& x) {
+      if (is_radical(x)) {
+        const ex key = GiNaC::expand(x.op(0));
+        auto it = index_.find(key);
+        if (it == index_.end()) {
+          it = index_.emplace(key, roots_.size()).first;
+          roots_.push_back({GiNaC::symbol(), 1, ex(), false});
+        }
+        Root& r = roots_[it->second];
+        r.Q = GiNaC::lcm(r.Q, GiNaC::ex_to<GiNaC::numeric>(x.op(1)).denom());
+      }
+      return false;
+    });
+  }
+  ex rewrite(const ex& e) {
+    if (e.nops() == 0) return e;
+    const auto done = rewritten_.find(e);
+    if (done != rewritten_.end()) return done->second;
+    ex result;
+    if (is_radical(e)) {
+      Root& r = roots_[index_.at(GiNaC::expand(e.op(0)))];
+      if (!r.has_base) {
+        r.base = GiNaC::expand(rewrite(e.op(0)));
+        r.has_base = true;
+      }
+      result = GiNaC::pow(r.t, GiNaC::ex_to<GiNaC::numeric>(e.op(1)) * r.Q);
+    } else {
+      Operands f(*this);
+      result = e.map(f);
+    }
+    rewritten_.emplace(e, result);
+    return result;
+  }
+  struct Operands : GiNaC::map_function {
+    explicit Operands(RadicalsToSymbols& r) : radicals(r) {}
+    ex operator()(const ex& e) override { return radicals.rewrite(e); }
+    RadicalsToSymbols& radicals;
+  };
+
+  std::vector<Root> roots_;
+  std::map<ex, std::size_t, GiNaC::ex_is_less> index_;
+  std::map<ex, ex, GiNaC::ex_is_less> rewritten_;
+};
+
+// A polynomial in c_a of degree ≤ 1 for every argument a, using c² = 1 − s², and of degree < Q in
+// every radical t = B^(1/Q), using t^Q = B (B may hold other radicals and sines: repeated until
+// none applies).
+ex reduce_pythagoras(ex e, const TrigToSymbols& trig, const std::vector<RadicalsToSymbols::Root>& roots = {}) {
   e = GiNaC::expand(e);
-  for (const auto& [arg, sc] : trig.pairs) {
-    const auto& [s, c] = sc;
-    for (int d = e.degree(c); d >= 2; d = e.degree(c)) {
-      const ex k = e.coeff(c, d);
-      e = GiNaC::expand(e - k * GiNaC::pow(c, d) + k * GiNaC::pow(c, d - 2) * (1 - GiNaC::pow(s, 2)));
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (const RadicalsToSymbols::Root& r : roots) {
+      const int Q = r.Q.to_int();
+      for (int d = e.degree(r.t); d >= Q; d = e.degree(r.t)) {
+        const ex k = e.coeff(r.t, d);
+        e = GiNaC::expand(e - k * GiNaC::pow(r.t, d) + k * GiNaC::pow(r.t, d - Q) * r.base);
+        changed = true;
+      }
+    }
+    for (const auto& [arg, sc] : trig.pairs) {
+      const auto& [s, c] = sc;
+      for (int d = e.degree(c); d >= 2; d = e.degree(c)) {
+        const ex k = e.coeff(c, d);
+        e = GiNaC::expand(e - k * GiNaC::pow(c, d) + k * GiNaC::pow(c, d - 2) * (1 - GiNaC::pow(s, 2)));
+      }
     }
   }
   return e;
@@ -121,13 +207,14 @@ bool holds_division(const ex& e, bool tan_divides = false) {
 // the budgets (kProofBudget, kExpansionBudget); nothing otherwise.
 struct ProofForm {
   TrigToSymbols trig;
+  RadicalsToSymbols radicals;
   ex symbolic;
   bool division = false;  // holds_division(symbolic)
 };
 std::optional<ProofForm> proof_form(const ex& written_out, TreeSize& written_size, bool bound_terms) {
   if (written_size(written_out) > kProofBudget) return std::nullopt;
   ProofForm f;
-  f.symbolic = written_out.map(f.trig);
+  f.symbolic = f.radicals.replace(written_out.map(f.trig));
   f.division = holds_division(f.symbolic);
   // A polynomial's bound is checked before normal(), which expands it (its numerator is the
   // polynomial). A rational expression's terms can cancel over a common denominator: the Whipple
@@ -149,10 +236,10 @@ Proof finish_proof(const ProofForm& f) {
   // A polynomial (no division or root: proof_form has bounded its expansion) is zero iff its
   // expansion is; normal() would reach the same numerator through gcd computations that cost
   // the 60-link chain's symmetry proofs about 15 s (2026-11-29).
-  if (!f.division) return reduce_pythagoras(f.symbolic, f.trig).is_zero() ? Proof::zero : Proof::nonzero;
+  if (!f.division) return reduce_pythagoras(f.symbolic, f.trig, f.radicals.roots()).is_zero() ? Proof::zero : Proof::nonzero;
   const ex numerator = GiNaC::normal(f.symbolic).numer();
   if (TreeSize(50 * kProofBudget + 1)(numerator) > 50 * kProofBudget) return Proof::too_large;
-  return reduce_pythagoras(numerator, f.trig).is_zero() ? Proof::zero : Proof::nonzero;
+  return reduce_pythagoras(numerator, f.trig, f.radicals.roots()).is_zero() ? Proof::zero : Proof::nonzero;
 }
 
 }  // namespace

@@ -2,8 +2,9 @@
 // generator: the structural zeros of the linear matrices, linear/structural_zeros.cpp, their
 // symmetry and sensitivities, and the constraint equations that vanish identically,
 // mechanics/loop_closure.cpp). Every intermediate is written out, sin and cos of each argument
-// replaced by symbols s, c with c² = 1 − s², the rational normal form's numerator expanded and
-// reduced; an expression beyond the size budgets is not proved (never a wrong zero).
+// replaced by symbols s, c with c² = 1 − s², the radicals of each base B by powers of one symbol
+// t = B^(1/Q) with t^Q = B, the rational normal form's numerator expanded and reduced by those
+// relations; an expression beyond the size budgets is not proved (never a wrong zero).
 #pragma once
 
 #include "mbsgen/generator/symbolic/program.hpp"
