@@ -13,7 +13,7 @@
 # models/middle_ear/middle_ear.yaml -- modes` (README) generates the same kernels itself.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/deps.sh
+scripts/deps.sh --demo
 
 # Build only what the demo needs. Parallel only while no other build is running.
 jobs=2

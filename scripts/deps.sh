@@ -3,6 +3,12 @@
 # arguments (scripts/fuzz.sh adds clang and libclang-rt-14-dev; the test suite needs neither).
 # As root: apt-get update, then apt-get install. Otherwise: prints the command and exits 1.
 #
+#   scripts/deps.sh [--demo] [PACKAGE...]
+#
+# --demo: only what scripts/demo.sh builds (the preset "demo": the runtime and the solver's command
+# line, without the generator, the tests, simulation or MPI), and gnuplot for its plot: 75 fewer
+# packages on a bare Debian 12 than the whole set (no GiNaC, OpenMPI, Boost, gfortran, SUNDIALS).
+#
 # SUNDIALS (CVODE, for simulate): the runtime library libsundials-cvode6 only, which holds CVODE
 # with the serial vector and the dense matrix and solver mbsgen uses. Debian's libsundials-dev,
 # the only package with the headers, depends on PETSc, HYPRE, MUMPS, Trilinos, HDF5 and gfortran
@@ -11,9 +17,18 @@
 # /usr/include has none (docs/building.md, "Dependencies").
 set -euo pipefail
 cd "$(dirname "$0")/.."
-packages=(cmake g++ make pkg-config libginac-dev libcln-dev libeigen3-dev libyaml-cpp-dev
-          libcli11-dev libgtest-dev liblapacke-dev libopenblas-dev gnuplot-nox libjemalloc-dev
-          libsundials-cvode6 libboost-dev libopenmpi-dev openmpi-bin "$@")
+demo=0
+if [ "${1:-}" = --demo ]; then
+  demo=1
+  shift
+fi
+if [ "$demo" = 1 ]; then
+  packages=(cmake g++ make pkg-config libeigen3-dev libcli11-dev liblapacke-dev libopenblas-dev gnuplot-nox "$@")
+else
+  packages=(cmake g++ make pkg-config libginac-dev libcln-dev libeigen3-dev libyaml-cpp-dev
+            libcli11-dev libgtest-dev liblapacke-dev libopenblas-dev gnuplot-nox libjemalloc-dev
+            libsundials-cvode6 libboost-dev libopenmpi-dev openmpi-bin "$@")
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -30,6 +45,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   apt-get update -qq
   apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+
+[ "$demo" = 1 ] && exit 0  # the demo's solver does not simulate: no SUNDIALS
 
 # The SUNDIALS headers of the installed library's version, unless libsundials-dev is installed.
 headers=build/deps/sundials

@@ -1,4 +1,5 @@
-# cmake --install into WORK/prefix, then configure, build and run examples/consumer against it.
+# cmake --install into WORK/prefix, then configure, build and run examples/consumer against it
+# (with CONSUMER_CXX_FLAGS and CONSUMER_LINKER_FLAGS when given: the sanitizers of the build).
 file(REMOVE_RECURSE ${WORK})
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE _rc OUTPUT_VARIABLE _out ERROR_VARIABLE _out)
@@ -10,7 +11,8 @@ function(run)
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK}/prefix)
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/consumer -B ${WORK}/build
-    -DCMAKE_PREFIX_PATH=${WORK}/prefix -DCMAKE_BUILD_TYPE=Release)
+    -DCMAKE_PREFIX_PATH=${WORK}/prefix -DCMAKE_BUILD_TYPE=Release
+    "-DCMAKE_CXX_FLAGS=${CONSUMER_CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_LINKER_FLAGS}")
 run(${CMAKE_COMMAND} --build ${WORK}/build -j2)
 run(${WORK}/build/pendulum_consumer)
 message("${_last_output}")

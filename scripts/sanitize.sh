@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Installs what is missing, then builds and runs the whole test suite under AddressSanitizer and
+# UndefinedBehaviorSanitizer with warnings as errors (preset "asan": gcc -O1 -g1 -DNDEBUG; the
+# sanitizers' options are in the preset's environment; docs/testing.md says which checks and why).
+# CI (.ci/run) runs it after scripts/test.sh. Arguments go to ctest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+phase() { echo "sanitize.sh: $1 ended after ${SECONDS} s" >&2; }
+scripts/deps.sh
+phase "packages"
+cmake --preset asan
+cmake --build --preset asan -j "$(nproc)"
+phase "build"
+ctest --preset asan -j "$(nproc)" "$@"
+phase "tests"
