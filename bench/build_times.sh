@@ -4,7 +4,7 @@
 # the wall time, the compile and link time summed per directory of the tree, and the heaviest
 # translation units and links.
 #
-#   bench/build_times.sh [--preset dev|ci|demo] [--target T] [--jobs N] [--dir DIR] [-DVAR=VALUE ...]
+#   bench/build_times.sh [--preset dev|ci|asan|demo] [--target T] [--jobs N] [--dir DIR] [-DVAR=VALUE ...]
 #
 # -D options go to the configuration (-DCMAKE_DISABLE_PRECOMPILE_HEADERS=ON: without precompiled
 # headers, for a comparison).
@@ -34,8 +34,8 @@ rm -rf "$dir"
 launcher="$PWD/bench/time_step.sh"
 cmake --preset "$preset" -B "$dir" -DCMAKE_CXX_COMPILER_LAUNCHER="$launcher" \
   -DCMAKE_CXX_LINKER_LAUNCHER="$launcher" "${defines[@]}" > /dev/null
-if [ "$preset" = ci ]; then
-  # The sanitizers' options of the ci build preset (CMakePresets.json): the build runs the
+if [ "$preset" = asan ]; then
+  # The sanitizers' options of the asan build preset (CMakePresets.json): the build runs the
   # instrumented generator and test executables, and CLN's one allocation at exit is suppressed.
   export ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1:check_initialization_order=1:strict_init_order=1
   export LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0"
