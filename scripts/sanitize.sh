@@ -3,13 +3,4 @@
 # UndefinedBehaviorSanitizer with warnings as errors (preset "asan": gcc -O1 -g1 -DNDEBUG; the
 # sanitizers' options are in the preset's environment; docs/testing.md says which checks and why).
 # CI (.ci/run) runs it after scripts/test.sh. Arguments go to ctest.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-phase() { echo "sanitize.sh: $1 ended after ${SECONDS} s" >&2; }
-scripts/deps.sh
-phase "packages"
-cmake --preset asan
-cmake --build --preset asan -j "$(nproc)"
-phase "build"
-ctest --preset asan -j "$(nproc)" "$@"
-phase "tests"
+exec "$(dirname "$0")/suite.sh" asan "$@"

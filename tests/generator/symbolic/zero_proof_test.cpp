@@ -32,19 +32,22 @@ TEST(ZeroProof, RadicalsOfOneBaseWrittenWithEitherSign) {
   EXPECT_TRUE(proved_zero(program, k * (pow(pow(x - y, 2), -half) - pow(pow(x - y, 2), -3 * half) * pow(x - y, 2))));
 }
 
+// d/da of the last spring's stiffness in the chain fixed at both ends (wall at 6a): the partial
+// derivative candidate of mbsgen generate's sensitivity screen, as written in a run where the
+// proof failed. With d = x5 − 6a and r = |d|, r² = d²:
+//   2d/r³ − (3d²/r⁵ − 1/r³)·d = 3d/r³ − 3d³/r⁵ = 0, so the second term vanishes, and
+//   18·(1/r − d²/r³)·d/r = 0, (1/r − d²/r³) = 0.
+ex spring_to_a_wall_candidate(const GiNaC::symbol& x5, const GiNaC::symbol& a, const GiNaC::symbol& k) {
+  const ex d = x5 - 6 * a, d2 = pow(d, 2);
+  return -18 * (pow(d2, -half) - d2 * pow(d2, -3 * half)) * d * pow(d2, -half) * k +
+         6 * (GiNaC::sqrt(d2) - a) * (2 * d * pow(d2, -3 * half) + (pow(d2, -3 * half) - 3 * d2 * pow(d2, -5 * half)) * d) * k -
+         (pow(d2, -half) - d2 * pow(d2, -3 * half)) * k;
+}
+
 TEST(ZeroProof, SpringToAWallCandidateOfTheSensitivityKernel) {
-  // d/da of the last spring's stiffness in the chain fixed at both ends (wall at 6a): the partial
-  // derivative candidate of mbsgen generate's sensitivity screen, as written in a run where the
-  // proof failed. With d = x5 − 6a and r = |d|, r² = d²:
-  //   2d/r³ − (3d²/r⁵ − 1/r³)·d = 3d/r³ − 3d³/r⁵ = 0, so the second term vanishes, and
-  //   18·(1/r − d²/r³)·d/r = 0, (1/r − d²/r³) = 0.
   const GiNaC::symbol x5("x5"), a("a"), k("k");
   Program program;
-  const ex d = x5 - 6 * a, d2 = pow(d, 2);
-  const ex e = -18 * (pow(d2, -half) - d2 * pow(d2, -3 * half)) * d * pow(d2, -half) * k +
-               6 * (GiNaC::sqrt(d2) - a) * (2 * d * pow(d2, -3 * half) + (pow(d2, -3 * half) - 3 * d2 * pow(d2, -5 * half)) * d) * k -
-               (pow(d2, -half) - d2 * pow(d2, -3 * half)) * k;
-  EXPECT_TRUE(proved_zero(program, e));
+  EXPECT_TRUE(proved_zero(program, spring_to_a_wall_candidate(x5, a, k)));
 }
 
 // The same candidate with fresh symbols 200 times: GiNaC orders a sum's and a product's operands
@@ -58,11 +61,7 @@ TEST(ZeroProof, RadicalsAreProvedInEveryOperandOrder) {
   for (int round = 0; round < 200; ++round) {
     const GiNaC::symbol x5("x5"), a("a"), k("k");
     Program program;
-    const ex d = x5 - 6 * a, d2 = pow(d, 2);
-    const ex e = -18 * (pow(d2, -half) - d2 * pow(d2, -3 * half)) * d * pow(d2, -half) * k +
-                 6 * (GiNaC::sqrt(d2) - a) * (2 * d * pow(d2, -3 * half) + (pow(d2, -3 * half) - 3 * d2 * pow(d2, -5 * half)) * d) * k -
-                 (pow(d2, -half) - d2 * pow(d2, -3 * half)) * k;
-    if (!proved_zero(program, e)) ++failed;
+    if (!proved_zero(program, spring_to_a_wall_candidate(x5, a, k))) ++failed;
   }
   EXPECT_EQ(failed, 0) << "of 200 operand orders";
 }
