@@ -19,10 +19,8 @@ using GiNaC::ex;
 using GiNaC::cos_SERIAL;
 using GiNaC::sin_SERIAL;
 using GiNaC::tan_SERIAL;
-using detail::kProofBudget;
 using detail::Proof;
-using detail::prove_zero;
-using detail::TreeSize;
+using detail::Prover;
 
 namespace {
 
@@ -120,15 +118,15 @@ struct Outcome {
 // Proves entry x zero everywhere (a candidate there), else at the operating point `op` (a
 // candidate there).
 Outcome settle(Program& program, const ex& x, bool candidate_everywhere, bool candidate_at_op,
-               Program::Substitution& op, TreeSize& written_size) {
+               Program::Substitution& op, Prover& prover) {
   Outcome o;
   if (candidate_everywhere) {
-    const Proof p = prove_zero(program.inline_all(x), written_size);
+    const Proof p = prover.prove(program.inline_all(x));
     if (p == Proof::zero) return {EntryZero::everywhere, 0};
     if (p == Proof::too_large) ++o.unproved;
   }
   if (candidate_at_op) {
-    const Proof p = prove_zero(program.inline_all(program.substitute(x, op)), written_size);
+    const Proof p = prover.prove(program.inline_all(program.substitute(x, op)));
     if (p == Proof::zero) o.zero = EntryZero::at_operating_point;
     if (p == Proof::too_large) ++o.unproved;
   }
@@ -165,7 +163,7 @@ StructuralZeros detail::find_structural_zeros(Equations& eq, LinearEquations& li
     op_values[eq.yd[k]] = lin.yd0[k];
   }
   Program::Substitution op(op_values);
-  TreeSize written_size(kProofBudget + 1);
+  Prover prover;
   for (std::size_t m = 0; m < ts.size(); ++m) {
     ExMatrix& A = *ts[m].matrix;
     std::vector<std::vector<Outcome>> settled;  // of a mirrored matrix, for its lower triangle
@@ -182,7 +180,7 @@ StructuralZeros detail::find_structural_zeros(Equations& eq, LinearEquations& li
         } else {
           const bool known_at_op = given && ts[m].zero_at_operating_point;
           o = settle(eq.program, A[i][j], everywhere[m][i][j] == EntryZero::everywhere,
-                     given && !known_at_op && at_op[m][i][j] == EntryZero::everywhere, op, written_size);
+                     given && !known_at_op && at_op[m][i][j] == EntryZero::everywhere, op, prover);
           if (known_at_op && o.zero == EntryZero::nonzero) o.zero = EntryZero::at_operating_point;
           if (ts[m].mirrored) settled[i][j] = o;
         }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <map>
 #include <optional>
+#include <set>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -41,23 +42,42 @@ bool any_node(const ex& e, Test&& test) {
   return false;
 }
 
-// sin(a), cos(a), tan(a) → s_a, c_a, s_a/c_a, one pair of symbols per argument a.
+// Results kept by node, with the node: kept alive, its address is not taken by another.
+template <class T>
+using NodeMemo = std::unordered_map<const GiNaC::basic*, std::pair<ex, T>>;
+
+// sin(a), cos(a), tan(a) → s_a, c_a, s_a/c_a, one pair of symbols per argument a; a node shared
+// by several subtrees (or candidates) is mapped once, and its image is shared as it was.
 struct TrigToSymbols : GiNaC::map_function {
   std::map<ex, std::pair<GiNaC::symbol, GiNaC::symbol>, GiNaC::ex_is_less> pairs;
+  NodeMemo<ex> images;
   const std::pair<GiNaC::symbol, GiNaC::symbol>& pair_of(const ex& a) {
     auto it = pairs.find(a);
     if (it == pairs.end()) it = pairs.emplace(a, std::make_pair(GiNaC::symbol(), GiNaC::symbol())).first;
     return it->second;
   }
   ex operator()(const ex& e) override {
+    if (e.nops() == 0) return e;
+    const GiNaC::basic* node = &GiNaC::ex_to<GiNaC::basic>(e);
+    if (const auto it = images.find(node); it != images.end()) return it->second.second;
     const bool s = is_ex_the_function(e, sin), c = is_ex_the_function(e, cos),
                t = is_ex_the_function(e, tan);
+    ex image;
     if (s || c || t) {
       const ex arg = e.op(0).map(*this);
       const auto& [sa, ca] = pair_of(arg);
-      return s ? ex(sa) : c ? ex(ca) : ex(sa) / ca;
+      image = s ? ex(sa) : c ? ex(ca) : ex(sa) / ca;
+    } else {
+      image = e.map(*this);
     }
-    return e.map(*this);
+    images.emplace(node, std::make_pair(e, image));
+    return image;
+  }
+  // The (s, c) pairs, for reduce_pythagoras.
+  std::vector<std::pair<ex, ex>> all_pairs() const {
+    std::vector<std::pair<ex, ex>> v;
+    for (const auto& [arg, sc] : pairs) v.emplace_back(sc.first, sc.second);
+    return v;
   }
 };
 
@@ -137,7 +157,7 @@ class RadicalsToSymbols {
 // A polynomial in c_a of degree ≤ 1 for every argument a, using c² = 1 − s², and of degree < Q in
 // every radical t = B^(1/Q), using t^Q = B (B may hold other radicals and sines: repeated until
 // none applies).
-ex reduce_pythagoras(ex e, const TrigToSymbols& trig, const std::vector<RadicalsToSymbols::Root>& roots = {}) {
+ex reduce_pythagoras(ex e, const std::vector<std::pair<ex, ex>>& trig, const std::vector<RadicalsToSymbols::Root>& roots = {}) {
   e = GiNaC::expand(e);
   for (bool changed = true; changed;) {
     changed = false;
@@ -149,8 +169,7 @@ ex reduce_pythagoras(ex e, const TrigToSymbols& trig, const std::vector<Radicals
         changed = true;
       }
     }
-    for (const auto& [arg, sc] : trig.pairs) {
-      const auto& [s, c] = sc;
+    for (const auto& [s, c] : trig) {
       for (int d = e.degree(c); d >= 2; d = e.degree(c)) {
         const ex k = e.coeff(c, d);
         e = GiNaC::expand(e - k * GiNaC::pow(c, d) + k * GiNaC::pow(c, d - 2) * (1 - GiNaC::pow(s, 2)));
@@ -170,37 +189,54 @@ constexpr std::size_t kExpansionBudget = 10000;
 
 // An upper bound of the number of terms of e expanded, saturating at `limit`: a sum's terms add,
 // a product's multiply, a power with a positive integer exponent n raises its base's to n;
-// anything else is one term.
-std::size_t expanded_terms(const ex& e, std::size_t limit) {
+// anything else is one term. With `known`, the bound of every node is kept there (for one limit)
+// and a node seen before is not walked again.
+std::size_t expanded_terms(const ex& e, std::size_t limit, NodeMemo<std::size_t>* known = nullptr) {
+  if (e.nops() == 0) return 1;
+  if (known)
+    if (const auto it = known->find(&GiNaC::ex_to<GiNaC::basic>(e)); it != known->end()) return it->second.second;
   const auto times = [limit](std::size_t a, std::size_t b) { return b != 0 && a > limit / b ? limit : std::min(limit, a * b); };
+  std::size_t t = 1;
   if (isa<GiNaC::add>(e)) {
-    std::size_t t = 0;
-    for (std::size_t i = 0; i < e.nops() && t < limit; ++i) t = std::min(limit, t + expanded_terms(e.op(i), limit));
-    return t;
+    t = 0;
+    for (std::size_t i = 0; i < e.nops() && t < limit; ++i) t = std::min(limit, t + expanded_terms(e.op(i), limit, known));
+  } else if (isa<GiNaC::mul>(e)) {
+    for (std::size_t i = 0; i < e.nops() && t < limit; ++i) t = times(t, expanded_terms(e.op(i), limit, known));
+  } else if (isa<GiNaC::power>(e) && isa<GiNaC::numeric>(e.op(1)) && GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_pos_integer()) {
+    const std::size_t base = expanded_terms(e.op(0), limit, known);
+    t = base;
+    if (base > 1) {
+      t = 1;
+      for (GiNaC::numeric k = GiNaC::ex_to<GiNaC::numeric>(e.op(1)); k.is_positive() && t < limit; k -= 1) t = times(t, base);
+    }
   }
-  if (isa<GiNaC::mul>(e)) {
-    std::size_t t = 1;
-    for (std::size_t i = 0; i < e.nops() && t < limit; ++i) t = times(t, expanded_terms(e.op(i), limit));
-    return t;
-  }
-  if (isa<GiNaC::power>(e) && isa<GiNaC::numeric>(e.op(1)) && GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_pos_integer()) {
-    const std::size_t base = expanded_terms(e.op(0), limit);
-    if (base <= 1) return base;
-    std::size_t t = 1;
-    for (GiNaC::numeric k = GiNaC::ex_to<GiNaC::numeric>(e.op(1)); k.is_positive() && t < limit; k -= 1) t = times(t, base);
-    return t;
-  }
-  return 1;
+  if (known) known->emplace(&GiNaC::ex_to<GiNaC::basic>(e), std::make_pair(e, t));
+  return t;
 }
 
-// Whether e holds a power that is not a positive integer one (a division or a root), or, with
-// tan_divides, a tangent (which the proof form writes s/c).
+// Whether test(x) holds for a node x of e, with every node's answer kept in `known` (for one test)
+// and a node seen before not walked again.
+template <class Test>
+bool any_node_known(const ex& e, const Test& test, NodeMemo<bool>& known) {
+  if (e.nops() == 0) return test(e);
+  const GiNaC::basic* node = &GiNaC::ex_to<GiNaC::basic>(e);
+  if (const auto it = known.find(node); it != known.end()) return it->second.second;
+  bool holds = test(e);
+  for (std::size_t i = 0; i < e.nops() && !holds; ++i) holds = any_node_known(e.op(i), test, known);
+  known.emplace(node, std::make_pair(e, holds));
+  return holds;
+}
+
+// A power that is not a positive integer one (a division or a root), or, with tan_divides, a
+// tangent (which the proof form writes s/c).
+bool divides(const ex& x, bool tan_divides) {
+  return (isa<GiNaC::power>(x) && !(isa<GiNaC::numeric>(x.op(1)) && GiNaC::ex_to<GiNaC::numeric>(x.op(1)).is_pos_integer())) ||
+         (tan_divides && is_ex_the_function(x, tan));
+}
+
+// Whether e holds a node that divides(…, tan_divides).
 bool holds_division(const ex& e, bool tan_divides = false) {
-  return any_node(e, [tan_divides](const ex& x) {
-    return (isa<GiNaC::power>(x) &&
-            !(isa<GiNaC::numeric>(x.op(1)) && GiNaC::ex_to<GiNaC::numeric>(x.op(1)).is_pos_integer())) ||
-           (tan_divides && is_ex_the_function(x, tan));
-  });
+  return any_node(e, [tan_divides](const ex& x) { return divides(x, tan_divides); });
 }
 
 // A written-out candidate with sin, cos and tan of each argument as symbols, when it is within
@@ -224,31 +260,63 @@ std::optional<ProofForm> proof_form(const ex& written_out, TreeSize& written_siz
   return f;
 }
 
-// Whether proof_form(written_out, written_size, true) would give a form, without making it (its
-// sines and cosines as symbols change neither the terms' count nor, but for tan = s/c, whether it
-// divides).
-bool within_budgets(const ex& written_out, TreeSize& written_size) {
-  if (written_size(written_out) > kProofBudget) return false;
-  return holds_division(written_out, true) || expanded_terms(written_out, kExpansionBudget + 1) <= kExpansionBudget;
-}
-
 Proof finish_proof(const ProofForm& f) {
   // A polynomial (no division or root: proof_form has bounded its expansion) is zero iff its
   // expansion is; normal() would reach the same numerator through gcd computations that cost
   // the 60-link chain's symmetry proofs about 15 s (2026-11-29).
-  if (!f.division) return reduce_pythagoras(f.symbolic, f.trig, f.radicals.roots()).is_zero() ? Proof::zero : Proof::nonzero;
+  if (!f.division) return reduce_pythagoras(f.symbolic, f.trig.all_pairs(), f.radicals.roots()).is_zero() ? Proof::zero : Proof::nonzero;
   const ex numerator = GiNaC::normal(f.symbolic).numer();
   if (TreeSize(50 * kProofBudget + 1)(numerator) > 50 * kProofBudget) return Proof::too_large;
-  return reduce_pythagoras(numerator, f.trig, f.radicals.roots()).is_zero() ? Proof::zero : Proof::nonzero;
+  return reduce_pythagoras(numerator, f.trig.all_pairs(), f.radicals.roots()).is_zero() ? Proof::zero : Proof::nonzero;
 }
 
 }  // namespace
 
-// written_size: a TreeSize with the limit kProofBudget + 1, kept from one candidate to the next.
-Proof detail::prove_zero(const ex& written_out, TreeSize& written_size) {
+struct detail::Prover::Shared {
+  TreeSize written_size{kProofBudget + 1};
+  NodeMemo<std::size_t> terms;  // expanded_terms with the limit kExpansionBudget + 1
+  NodeMemo<bool> division;      // holds_division with tan_divides
+  NodeMemo<bool> trigonometric;  // whether a node holds a sine, cosine or tangent
+  TrigToSymbols trig;
+
+  bool divides(const ex& written_out) {
+    return any_node_known(written_out, [](const ex& x) { return mbsgen::divides(x, true); }, division);
+  }
+};
+
+detail::Prover::Prover() : shared_(std::make_unique<Shared>()) {}
+detail::Prover::~Prover() = default;
+
+bool detail::Prover::within_budgets(const ex& written_out) {
+  // As proof_form(written_out, …, true) decides.
+  if (shared_->written_size(written_out) > kProofBudget) return false;
+  return shared_->divides(written_out) ||
+         expanded_terms(written_out, kExpansionBudget + 1, &shared_->terms) <= kExpansionBudget;
+}
+
+Proof detail::Prover::prove(const ex& written_out) {
   if (written_out.is_zero()) return Proof::zero;
-  const std::optional<ProofForm> f = proof_form(written_out, written_size, true);
-  return f ? finish_proof(*f) : Proof::too_large;
+  if (!within_budgets(written_out)) return Proof::too_large;
+  Shared& s = *shared_;
+  // A rational expression or a radical: normal() of this candidate alone, as proof_form makes it.
+  if (s.divides(written_out)) return finish_proof(*proof_form(written_out, s.written_size, false));
+  // A polynomial: expanded and reduced by c² = 1 − s² for the arguments whose cosine it holds, as
+  // finish_proof does, with its sines and cosines as the symbols of earlier candidates.
+  const bool trigonometric = any_node_known(
+      written_out, [](const ex& x) { return is_ex_the_function(x, sin) || is_ex_the_function(x, cos) || is_ex_the_function(x, tan); },
+      s.trigonometric);
+  const ex polynomial = GiNaC::expand(trigonometric ? s.trig(written_out) : written_out);
+  std::vector<std::pair<ex, ex>> pairs;
+  if (!s.trig.pairs.empty()) {
+    std::set<ex, GiNaC::ex_is_less> symbols;
+    any_node(polynomial, [&symbols](const ex& x) {
+      if (isa<GiNaC::symbol>(x)) symbols.insert(x);
+      return false;
+    });
+    for (const auto& [arg, sc] : s.trig.pairs)
+      if (symbols.count(sc.second) > 0) pairs.emplace_back(sc.first, sc.second);
+  }
+  return reduce_pythagoras(polynomial, pairs).is_zero() ? Proof::zero : Proof::nonzero;
 }
 
 bool proved_zero(Program& program, const ex& e, bool bound_terms) {
@@ -260,20 +328,19 @@ bool proved_zero(Program& program, const ex& e, bool bound_terms) {
 
 bool all_proved_zero(Program& program, std::size_t count, const std::function<ex(std::size_t)>& entry) {
   // Every one within the budgets first: one beyond them decides, before any is expanded. The
-  // written-out forms share their subtrees (inline_all); the forms with symbols for the sines and
-  // cosines would not, so they are made again for the proofs, one at a time.
-  TreeSize written_size(kProofBudget + 1);
+  // written-out forms share their subtrees (inline_all), and so do their proofs (Prover).
+  detail::Prover prover;
   std::vector<ex> written;
   for (std::size_t k = 0; k < count; ++k) {
     const ex e = entry(k);
     if (e.is_zero()) continue;
     const ex written_out = program.inline_all(e);
     if (written_out.is_zero()) continue;
-    if (!within_budgets(written_out, written_size)) return false;
+    if (!prover.within_budgets(written_out)) return false;
     written.push_back(written_out);
   }
   for (const ex& w : written)
-    if (finish_proof(*proof_form(w, written_size, false)) != Proof::zero) return false;
+    if (prover.prove(w) != Proof::zero) return false;
   return true;
 }
 
