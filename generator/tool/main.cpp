@@ -204,6 +204,9 @@ int main(int argc, char** argv) try {
   generate->add_option("--part-operations", part_operations,
                        "operations per part of a long kernel, one longer than 4 times this (default 5000; 0: no kernel is cut, as before issue 17)")
       ->check(CLI::Range(std::size_t{0}, std::size_t{10000000}));
+  auto* tape_cmd = app.add_subcommand("tape", "make sure a model's tape is cached (as mbsgen run makes it) and print its path");
+  tape_cmd->add_option("MODEL", model_file, "model file (YAML)")->required();
+  tape_cmd->add_option("--scene", scene, "scene (default: the full model)");
   app.add_subcommand("linear", "modes and frequency responses of raw matrices (mbsgen linear --help)");
   app.add_subcommand("run", "generate, compile, cache and run a model's solver (mbsgen run --help)");
   auto* cache = app.add_subcommand("cache", "list, describe or clean the cache of mbsgen run");
@@ -223,6 +226,17 @@ int main(int argc, char** argv) try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (*tape_cmd) {
+    try {
+      return mbsgen::tool::tape_main(model_file, scene);
+    } catch (const mbsgen::ModelError& e) {
+      std::cerr << e.what() << "\n";
+      return 1;
+    } catch (const std::exception& e) {
+      std::cerr << "mbsgen tape: error: " << e.what() << "\n";
+      return 1;
+    }
   }
   if (*cache) {
     if (*cache_info) return mbsgen::tool::cache_info();

@@ -487,6 +487,32 @@ std::optional<int> run_tape(const std::string& model_file, const std::string& sc
 }  // namespace
 #endif  // MBSGEN_RUN_AVAILABLE
 
+int tape_main(const std::string& model_file, const std::string& scene) {
+#ifndef MBSGEN_RUN_AVAILABLE
+  (void)model_file, (void)scene;
+  std::cerr << "mbsgen tape: this mbsgen was built without the runtime (MBSGEN_BUILD_RUNTIME=OFF)\n";
+  return 1;
+#else
+  const std::string text = read_model_text(model_file);  // throws: reported by the caller, exit 1
+  cache_limit();
+  const fs::path dir = entry_dir(tape_key(text, scene));
+  std::optional<EntryLock> lock;
+  if (const int status = ensure_entry(dir, "tape", model_file, lock, [&] {
+        Progress progress("tape");
+        build_tape(model_file, scene, text, dir, lock, progress);
+        return 0;
+      }))
+    return status;
+  std::error_code ec;
+  if (fs::file_size(dir / "tape", ec) == 0 && !ec) {
+    std::cerr << "mbsgen tape: " << model_file << " has closed loops, whose kernels only compiled code evaluates: no tape\n";
+    return 3;
+  }
+  std::cout << (dir / "tape").string() << "\n";
+  return 0;
+#endif
+}
+
 int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args, bool compiled,
              bool debug) {
 #ifndef MBSGEN_RUN_AVAILABLE

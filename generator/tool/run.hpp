@@ -15,6 +15,11 @@ namespace mbsgen::tool {
 int run_main(const std::string& model_file, const std::string& scene, std::vector<std::string> args,
              bool compiled = false, bool debug = false);
 
+/// `mbsgen tape MODEL [--scene NAME]`: makes sure model_file's tape is in the cache (generating
+/// it as `mbsgen run` does) and prints its path on stdout; exit 3, with a message, for a model
+/// with closed loops (no tape). For programs that load the tape themselves (the Python package,
+/// mbsgen::TapeModel). Throws as run_main.
+int tape_main(const std::string& model_file, const std::string& scene);
 /// A T made by make() and never destroyed. The derivation of a large model is millions of GiNaC
 /// nodes, and freeing them one by one took 5 % of a 40-link chain's generation; the process's
 /// exit reclaims them at once. A global list keeps them reachable (no leak for LeakSanitizer).

@@ -1,0 +1,238 @@
+"""mbsgen from Python: multibody models as NumPy arrays (docs/python.md).
+
+    import mbsgen
+    ear = mbsgen.Model("models/middle_ear/middle_ear.yaml", scene="air_conduction")
+    modes = ear.modes()                      # eigenvalues, frequencies, damping, error bounds
+    h = ear.frf("p_ec", "v_stapes", np.logspace(2, 4, 300), k_al_z=500.0)
+
+A model file is generated into mbsgen's cache as `mbsgen run` does it (the first time, through
+the `mbsgen` command; later from the cache) and evaluated in this process from its tape, without
+a compiler. Every analysis takes parameter values by keyword; the others keep their defaults.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from typing import Dict, List, NamedTuple, Optional, Sequence
+
+import numpy as np
+
+from . import _mbsgen
+from ._mbsgen import Error
+
+__all__ = ["Model", "Parameter", "Error", "ModelError", "linear", "tool"]
+__version__ = _mbsgen.__version__
+
+
+class ModelError(Error):
+    """A model file the generator refuses; the message is the generator's (file:line:col: what)."""
+
+
+class Parameter(NamedTuple):
+    name: str
+    default: float
+    unit: str
+
+
+def tool() -> str:
+    """The mbsgen command the package uses for model files: $MBSGEN when set, else the one it was
+    built with (build tree) or installed with, else `mbsgen` on PATH."""
+    given = os.environ.get("MBSGEN")
+    if given:
+        return given
+    recorded = os.path.join(os.path.dirname(__file__), "tool_path.txt")
+    try:
+        with open(recorded, encoding="utf-8") as f:
+            path = f.read().strip()
+        if path and os.access(path, os.X_OK):
+            return path
+    except OSError:
+        pass
+    found = shutil.which("mbsgen")
+    if found:
+        return found
+    raise Error("mbsgen: the mbsgen command was not found (set MBSGEN to its path, or put it on PATH)")
+
+
+def _cached_tape(path: str, scene: Optional[str]) -> str:
+    # The generator as a separate program, its arguments a list: nothing goes through a shell.
+    args = [tool(), "tape", path]
+    if scene is not None:
+        args += ["--scene", scene]
+    done = subprocess.run(args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                          text=True, check=False)
+    if done.returncode != 0:
+        raise ModelError(done.stderr.strip() or f"mbsgen tape {path} failed (exit {done.returncode})")
+    return done.stdout.strip()
+
+
+class Modes(NamedTuple):
+    """Eigenvalues λ (1/s) of λ²M + λQ + K (one per conjugate pair unless all=True), with their
+    natural and damped frequencies (Hz), damping ratios, backward errors, absolute error bounds,
+    kinds ("finite", "zero", "infinite", "zero_within_bound"), right eigenvectors (columns of
+    shapes), the stability verdict that respects the error bounds, and the method."""
+
+    eigenvalues: np.ndarray
+    natural_frequency_hz: np.ndarray
+    damped_frequency_hz: np.ndarray
+    damping_ratio: np.ndarray
+    backward_error: np.ndarray
+    error_bound: np.ndarray
+    kinds: List[str]
+    shapes: np.ndarray
+    stability: str
+    method: str
+
+
+class Response(NamedTuple):
+    """A frequency response: the complex output per unit input at each frequency, the reciprocal
+    condition number of each solve, a flag per frequency ("ok", "ill_conditioned", "pole"), the
+    solver's warnings and the method used."""
+
+    frequencies_hz: np.ndarray
+    values: np.ndarray
+    rcond: np.ndarray
+    flags: List[str]
+    warnings: List[str]
+    method: str
+
+
+def _modes(m) -> Modes:
+    return Modes(m.eigenvalues, m.natural_frequency_hz, m.damped_frequency_hz, m.damping_ratio, m.backward_error,
+                 m.error_bound, list(m.kinds), m.shapes, m.stability, m.method)
+
+
+def _frequencies(frequencies) -> np.ndarray:
+    hz = np.ascontiguousarray(frequencies, dtype=np.float64)
+    if hz.ndim != 1:
+        raise ValueError(f"frequencies: a 1-D array of frequencies in Hz, not one of shape {hz.shape}")
+    if not np.all(np.isfinite(hz)) or np.any(hz < 0):
+        raise ValueError("frequencies: every frequency must be finite and >= 0 Hz")
+    return hz
+
+
+class Model:
+    """A multibody model: Model(path, scene=None) for a model file (YAML, generated and cached as
+    `mbsgen run` does) or a tape (`.tape`, from `mbsgen generate --tape`).
+
+    parameters, coordinates, inputs and outputs name what the analyses take and return; each
+    analysis takes parameter values by keyword (SI units), the others keeping their defaults."""
+
+    def __init__(self, path, scene: Optional[str] = None):
+        path = os.fspath(path)
+        tape = path if path.endswith(".tape") and scene is None else _cached_tape(path, scene)
+        self._tape = _mbsgen.TapeModel(tape)
+        names = self._tape.parameter_names
+        self._index: Dict[str, int] = {n: i for i, n in enumerate(names)}
+        self.parameters: List[Parameter] = [
+            Parameter(n, float(d), u) for n, d, u in zip(names, self._tape.parameter_defaults, self._tape.parameter_units)]
+        self.coordinates: List[str] = list(self._tape.coordinate_names)
+        self.coordinate_units: List[str] = list(self._tape.coordinate_units)
+        self.inputs: List[str] = list(self._tape.input_names)
+        self.input_units: List[str] = list(self._tape.input_units)
+        self.outputs: List[str] = list(self._tape.output_names)
+        self.output_units: List[str] = list(self._tape.output_units)
+        self.name: str = self._tape.name
+        self.scene: str = self._tape.scene
+        self.evaluation: str = self._tape.evaluation
+
+    def __repr__(self) -> str:
+        return (f"<mbsgen.Model {self.name!r} scene {self.scene!r}: {len(self.coordinates)} coordinates, "
+                f"{len(self.parameters)} parameters, {len(self.inputs)} inputs, {len(self.outputs)} outputs>")
+
+    def parameter_values(self, **params: float) -> np.ndarray:
+        """Every parameter's value in the model's order: the defaults, with the given ones set."""
+        p = np.array([q.default for q in self.parameters], dtype=np.float64)
+        for name, value in params.items():
+            i = self._index.get(name)
+            if i is None:
+                known = ", ".join(self._index) or "none"
+                raise ValueError(f"model {self.name!r} has no parameter {name!r} (parameters: {known})")
+            try:
+                p[i] = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"parameter {name!r}: a number, not {value!r}") from None
+        return p
+
+    def operating_point(self, **params: float):
+        """y0, yd0 and how they were found (given by the model, or a static equilibrium)."""
+        return self._tape.operating_point(self.parameter_values(**params))
+
+    def static(self, **params: float):
+        """The static equilibrium (or the model's given operating point): as operating_point."""
+        return self.operating_point(**params)
+
+    def linear(self, **params: float):
+        """The linear model at the operating point: M, Q, K, B, C_y, C_v (and C_a, D, B1, B2, D1,
+        0×0 when zero) as NumPy arrays; for a model with rolling constraints E, A, B, C, D."""
+        return self._tape.linear(self.parameter_values(**params))
+
+    def modes(self, all: bool = False, **params: float) -> Modes:
+        """The eigenvalues of the linear model (see Modes)."""
+        return _modes(self._tape.modes(self.parameter_values(**params), all))
+
+    def frf(self, input: str, output: str, frequencies: Sequence[float], method: str = "auto",
+            **params: float) -> Response:
+        """The response of `output` to a harmonic `input` of unit amplitude at `frequencies` (Hz).
+        method: auto, direct, banded, hessenberg, modal or real (as `frf --method`)."""
+        hz = _frequencies(frequencies)
+        r = self._tape.frf(self.parameter_values(**params), input, output, hz, method)
+        return Response(hz, r.values, r.rcond, list(r.flags), list(r.warnings), r.method)
+
+    def output_values(self, **params: float) -> np.ndarray:
+        """The outputs at the operating point."""
+        return self._tape.outputs(self.parameter_values(**params))
+
+
+class linear:  # noqa: N801 (a namespace: mbsgen.linear.modes, mbsgen.linear.frf)
+    """Analyses of linear models given as matrices: M ÿ + Q ẏ + K y = B u, z = C_y y + C_v ẏ."""
+
+    @staticmethod
+    def _matrix(name: str, a, rows: int, cols: int) -> np.ndarray:
+        a = np.asarray(linear._dense(a), dtype=np.float64)
+        if a.ndim != 2 or a.shape != (rows, cols):
+            raise ValueError(f"{name}: shape {a.shape}, expected ({rows}, {cols})")
+        return np.asfortranarray(a)
+
+    @staticmethod
+    def _dense(a):
+        return a.toarray() if hasattr(a, "toarray") else a  # SciPy sparse matrices
+
+    @staticmethod
+    def modes(M, Q, K, all: bool = False) -> Modes:
+        """The eigenvalues of λ²M + λQ + K (Q None: zero)."""
+        M = np.asarray(linear._dense(M), dtype=np.float64)
+        if M.ndim != 2 or M.shape[0] != M.shape[1]:
+            raise ValueError(f"M: shape {M.shape}, expected a square matrix")
+        f = M.shape[0]
+        Q = np.zeros((f, f)) if Q is None else linear._dense(Q)
+        return _modes(_mbsgen.modes_of(linear._matrix("M", M, f, f), linear._matrix("Q", Q, f, f),
+                                       linear._matrix("K", linear._dense(K), f, f), all))
+
+    @staticmethod
+    def frf(M, Q, K, B, C_y, frequencies, input: int = 0, output: int = 0, C_v=None,
+            method: str = "auto") -> Response:
+        """The response of output row `output` to input column `input` (0-based) at `frequencies` (Hz)."""
+        M = np.asarray(linear._dense(M), dtype=np.float64)
+        if M.ndim != 2 or M.shape[0] != M.shape[1]:
+            raise ValueError(f"M: shape {M.shape}, expected a square matrix")
+        f = M.shape[0]
+        B = np.asarray(linear._dense(B), dtype=np.float64)
+        C_y = np.asarray(linear._dense(C_y), dtype=np.float64)
+        if B.ndim != 2 or C_y.ndim != 2:
+            raise ValueError(f"B and C_y: 2-D arrays, not of shapes {B.shape} and {C_y.shape}")
+        m, p = B.shape[1], C_y.shape[0]
+        if not 0 <= input < m:
+            raise ValueError(f"input: {input} is not a column of B ({m} columns)")
+        if not 0 <= output < p:
+            raise ValueError(f"output: {output} is not a row of C_y ({p} rows)")
+        Q = np.zeros((f, f)) if Q is None else linear._dense(Q)
+        C_v = np.zeros((p, f)) if C_v is None else linear._dense(C_v)
+        hz = _frequencies(frequencies)
+        r = _mbsgen.frf_of(linear._matrix("M", M, f, f), linear._matrix("Q", Q, f, f),
+                           linear._matrix("K", linear._dense(K), f, f), linear._matrix("B", B, f, m),
+                           linear._matrix("C_y", C_y, p, f), linear._matrix("C_v", C_v, p, f), input, output, hz,
+                           method)
+        return Response(hz, r.values, r.rcond, list(r.flags), list(r.warnings), r.method)

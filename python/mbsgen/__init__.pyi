@@ -1,0 +1,91 @@
+# Type hints of the mbsgen package (docs/python.md).
+from typing import List, NamedTuple, Optional, Sequence
+
+import numpy as np
+
+__version__: str
+
+class Error(RuntimeError): ...
+class ModelError(Error): ...
+
+class Parameter(NamedTuple):
+    name: str
+    default: float
+    unit: str
+
+class Modes(NamedTuple):
+    eigenvalues: np.ndarray
+    natural_frequency_hz: np.ndarray
+    damped_frequency_hz: np.ndarray
+    damping_ratio: np.ndarray
+    backward_error: np.ndarray
+    error_bound: np.ndarray
+    kinds: List[str]
+    shapes: np.ndarray
+    stability: str
+    method: str
+
+class Response(NamedTuple):
+    frequencies_hz: np.ndarray
+    values: np.ndarray
+    rcond: np.ndarray
+    flags: List[str]
+    warnings: List[str]
+    method: str
+
+class OperatingPoint:
+    y0: np.ndarray
+    yd0: np.ndarray
+    equilibrium: bool
+    iterations: int
+    residual_norm: float
+    report: str
+
+class Linear:
+    descriptor: bool
+    M: np.ndarray
+    Q: np.ndarray
+    K: np.ndarray
+    B: np.ndarray
+    C_y: np.ndarray
+    C_v: np.ndarray
+    C_a: np.ndarray
+    D: np.ndarray
+    B1: np.ndarray
+    B2: np.ndarray
+    D1: np.ndarray
+    E: np.ndarray
+    A: np.ndarray
+    C: np.ndarray
+    state_names: List[str]
+
+def tool() -> str: ...
+
+class Model:
+    name: str
+    scene: str
+    evaluation: str
+    parameters: List[Parameter]
+    coordinates: List[str]
+    coordinate_units: List[str]
+    inputs: List[str]
+    input_units: List[str]
+    outputs: List[str]
+    output_units: List[str]
+    def __init__(self, path: str, scene: Optional[str] = None) -> None: ...
+    def parameter_values(self, **params: float) -> np.ndarray: ...
+    def operating_point(self, **params: float) -> OperatingPoint: ...
+    def static(self, **params: float) -> OperatingPoint: ...
+    def linear(self, **params: float) -> Linear: ...
+    def modes(self, all: bool = False, **params: float) -> Modes: ...
+    def frf(self, input: str, output: str, frequencies: Sequence[float], method: str = "auto",
+            **params: float) -> Response: ...
+    def output_values(self, **params: float) -> np.ndarray: ...
+
+class linear:
+    @staticmethod
+    def modes(M: np.ndarray, Q: Optional[np.ndarray], K: np.ndarray, all: bool = False) -> Modes: ...
+    @staticmethod
+    def frf(M: np.ndarray, Q: Optional[np.ndarray], K: np.ndarray, B: np.ndarray, C_y: np.ndarray,
+            frequencies: Sequence[float], input: int = 0, output: int = 0, C_v: Optional[np.ndarray] = None,
+            method: str = "auto") -> Response: ...

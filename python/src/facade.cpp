@@ -1,0 +1,200 @@
+// The Python package's C++ side (facade.hpp).
+#include "facade.hpp"
+
+#include "mbsgen/runtime/error.hpp"
+#include "mbsgen/runtime/model/descriptor_model.hpp"
+#include "mbsgen/runtime/model/generated_model.hpp"
+#include "mbsgen/runtime/model/tape.hpp"
+#include "mbsgen/runtime/spectral/descriptor_eigen.hpp"
+#include "mbsgen/runtime/spectral/frequency_response.hpp"
+#include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
+
+#include <cmath>
+
+namespace mbsgen::python {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+std::vector<std::string> names(const char* const* list, int n) { return n > 0 && list ? name_list(list, n) : std::vector<std::string>(); }
+
+// A GeneratedModel over the tape's kernels with the parameters p (every one, in order).
+GeneratedModel configured(const TapeModel& tape, const ConstVectorRef& p) {
+  GeneratedModel model(tape.kernels());
+  model.set_parameters(std::vector<double>(p.data(), p.data() + p.size()));
+  return model;
+}
+
+Modes modes_from(const std::vector<Mode>& modes, Stability stability, std::string method, Eigen::Index f) {
+  Modes r;
+  const Eigen::Index n = static_cast<Eigen::Index>(modes.size());
+  r.eigenvalues.resize(n);
+  r.natural_frequency_hz.resize(n);
+  r.damped_frequency_hz.resize(n);
+  r.damping_ratio.resize(n);
+  r.backward_error.resize(n);
+  r.error_bound.resize(n);
+  r.shapes.resize(f, n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Mode& m = modes[static_cast<std::size_t>(k)];
+    r.eigenvalues[k] = m.lambda;
+    r.natural_frequency_hz[k] = m.natural_frequency_hz;
+    r.damped_frequency_hz[k] = m.damped_frequency_hz;
+    r.damping_ratio[k] = m.damping_ratio;
+    r.backward_error[k] = m.backward_error;
+    r.error_bound[k] = m.error_bound;
+    r.kinds.emplace_back(kind_label(m));
+    if (m.shape.size() == f) r.shapes.col(k) = m.shape;
+    else r.shapes.col(k).setConstant(std::complex<double>(std::nan(""), std::nan("")));
+  }
+  r.stability = to_string(stability);
+  r.method = std::move(method);
+  return r;
+}
+
+Modes quadratic_modes(const LinearModel& lin, bool all) {
+  QuadraticEigenOptions opt;
+  opt.one_per_conjugate_pair = !all;
+  QuadraticEigenSolver solver(lin.size(), opt);
+  solver.compute(lin);
+  return modes_from(solver.modes(), solver.stability(), solver.method(), lin.size());
+}
+
+Response second_order_response(const LinearModel& lin, Eigen::Index input, Eigen::Index output, const ConstVectorRef& hz,
+                               const std::string& method) {
+  FrfOptions opt;
+  opt.method = parse_frf_method(method);
+  FrequencyResponse frf(lin, opt);
+  frf.compute(Eigen::VectorXd(hz) * kTwoPi, input, {output});
+  Response r;
+  r.values = frf.response().row(0).transpose();
+  r.rcond = frf.rcond();
+  for (FrfFlag f : frf.flags()) r.flags.emplace_back(to_string(f));
+  r.warnings = frf.warnings();
+  r.method = to_string(frf.method());
+  return r;
+}
+
+}  // namespace
+
+Model::Model(const std::string& tape_path) : tape_(TapeModel::load(tape_path)) {}
+Model::~Model() = default;
+
+std::string Model::name() const { return tape_->kernels().model; }
+std::string Model::scene() const { return tape_->kernels().scene; }
+std::string Model::evaluation() const {
+  const char* e = tape_->kernels().evaluation;
+  return e ? e : "compiled";
+}
+std::vector<std::string> Model::parameter_names() const {
+  const ModelKernels& k = tape_->kernels();
+  return names(k.parameter_names, k.n_parameters);
+}
+std::vector<std::string> Model::parameter_units() const {
+  const ModelKernels& k = tape_->kernels();
+  return names(k.parameter_units, k.n_parameters);
+}
+Vector Model::parameter_defaults() const {
+  const ModelKernels& k = tape_->kernels();
+  return Eigen::Map<const Vector>(k.parameter_defaults, k.n_parameters);
+}
+std::vector<std::string> Model::coordinate_names() const {
+  const ModelKernels& k = tape_->kernels();
+  return names(k.coordinate_names, k.n_coordinates);
+}
+std::vector<std::string> Model::coordinate_units() const {
+  const ModelKernels& k = tape_->kernels();
+  return names(k.coordinate_units, k.n_coordinates);
+}
+std::vector<std::string> Model::input_names() const {
+  const ModelKernels& k = tape_->kernels();
+  return names(k.input_names, k.n_inputs);
+}
+std::vector<std::string> Model::input_units() const {
+  const ModelKernels& k = tape_->kernels();
+  return names(k.input_units, k.n_inputs);
+}
+std::vector<std::string> Model::output_names() const {
+  const ModelKernels& k = tape_->kernels();
+  return names(k.output_names, k.n_outputs);
+}
+std::vector<std::string> Model::output_units() const {
+  const ModelKernels& k = tape_->kernels();
+  return names(k.output_units, k.n_outputs);
+}
+bool Model::descriptor() const { return tape_->kernels().descriptor != nullptr; }
+double Model::default_from_hz() const { return tape_->kernels().default_from_hz; }
+double Model::default_to_hz() const { return tape_->kernels().default_to_hz; }
+int Model::default_points() const { return tape_->kernels().default_points; }
+
+OperatingPoint Model::operating_point(const ConstVectorRef& p) const {
+  const mbsgen::OperatingPoint op = configured(*tape_, p).operating_point();
+  return {op.y0, op.yd0, op.equilibrium, op.iterations, op.residual_norm, op.report};
+}
+
+Linear Model::linear(const ConstVectorRef& p) const {
+  const GeneratedModel model = configured(*tape_, p);
+  Linear r;
+  if (model.is_descriptor()) {
+    const DescriptorModel d = model.descriptor_model();
+    r.descriptor = true;
+    r.E = d.E(), r.A = d.A(), r.B = d.B(), r.C = d.C(), r.D = d.D();
+    r.state_names = d.state_names();
+    return r;
+  }
+  const LinearModel lin = model.linear_model();
+  r.M = lin.M(), r.Q = lin.Q(), r.K = lin.K(), r.B = lin.B(), r.C_y = lin.C_y(), r.C_v = lin.C_v();
+  r.C_a = lin.C_a(), r.D = lin.D(), r.B1 = lin.B1(), r.B2 = lin.B2(), r.D1 = lin.D1();
+  return r;
+}
+
+Modes Model::modes(const ConstVectorRef& p, bool all) const {
+  const GeneratedModel model = configured(*tape_, p);
+  if (model.is_descriptor()) {
+    const DescriptorModel d = model.descriptor_model();
+    DescriptorEigenOptions opt;
+    opt.one_per_conjugate_pair = !all;
+    DescriptorEigenSolver solver(opt);
+    solver.compute(d);
+    return modes_from(solver.modes(), solver.stability(), "descriptor", d.size());
+  }
+  return quadratic_modes(model.linear_model(), all);
+}
+
+Response Model::frf(const ConstVectorRef& p, const std::string& input, const std::string& output,
+                    const ConstVectorRef& hz, const std::string& method) const {
+  const GeneratedModel model = configured(*tape_, p);
+  const Eigen::Index in = model.input_index(input), out = model.output_index(output);
+  if (model.is_descriptor()) {
+    const DescriptorFrf d = descriptor_frequency_response(model.descriptor_model(), Eigen::VectorXd(hz) * kTwoPi, in, {out});
+    Response r;
+    r.values = d.response.row(0).transpose();
+    r.rcond = d.rcond;
+    for (FrfFlag f : d.flags) r.flags.emplace_back(to_string(f));
+    r.method = "direct";
+    return r;
+  }
+  const LinearModel lin = model.linear_model();
+  return second_order_response(lin, in, out, hz, method);
+}
+
+Vector Model::outputs(const ConstVectorRef& p) const {
+  const GeneratedModel model = configured(*tape_, p);
+  return model.outputs(model.operating_point());
+}
+
+Modes modes_of(const ConstMatrixRef& M, const ConstMatrixRef& Q, const ConstMatrixRef& K, bool all) {
+  const Eigen::Index f = M.rows();
+  const LinearModel lin(M, Q.size() == 0 ? Matrix::Zero(f, f) : Matrix(Q), K);
+  return quadratic_modes(lin, all);
+}
+
+Response frf_of(const ConstMatrixRef& M, const ConstMatrixRef& Q, const ConstMatrixRef& K, const ConstMatrixRef& B,
+                const ConstMatrixRef& C_y, const ConstMatrixRef& C_v, Eigen::Index input, Eigen::Index output,
+                const ConstVectorRef& hz, const std::string& method) {
+  const LinearModel lin(M, Q, K, B, C_y, C_v);
+  return second_order_response(lin, input, output, hz, method);
+}
+
+}  // namespace mbsgen::python

@@ -1,0 +1,112 @@
+// The C++ side of the Python package (issue 41): a model loaded from its tape and the analyses of
+// the runtime, with plain arguments and results — vectors and matrices of doubles, strings —
+// that any binding library converts. module.cpp binds them with pybind11; nothing here includes
+// it. The rules that keep a move to nanobind mechanical (docs/python.md, "The facade"): arrays
+// come in as Eigen::Ref (no copy of a NumPy array in the right layout), results are structs of
+// Eigen matrices and std::strings (no container of Eigen types), and no function here knows of
+// Python objects, the GIL or exceptions of the binding.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mbsgen {
+class TapeModel;
+}
+
+namespace mbsgen::python {
+
+using Vector = Eigen::VectorXd;
+using Matrix = Eigen::MatrixXd;
+using ConstVectorRef = Eigen::Ref<const Eigen::VectorXd>;
+using ConstMatrixRef = Eigen::Ref<const Eigen::MatrixXd>;
+
+/// The linear model at the operating point: M ÿ + Q ẏ + K y = B u (+ B1 u̇ + B2 ü),
+/// z = C_y y + C_v ẏ + C_a ÿ + D u (+ D1 u̇). C_a, D, B1, B2, D1 are 0×0 when zero; for a model with
+/// rolling constraints (descriptor) E ẋ = A x + B u, z = C x instead, M … D1 empty.
+struct Linear {
+  bool descriptor = false;
+  Matrix M, Q, K, B, C_y, C_v, C_a, D, B1, B2, D1;
+  Matrix E, A, C;                       // descriptor models only
+  std::vector<std::string> state_names;  // descriptor models: the coordinates, then "NAME_dot"
+};
+
+/// How the operating point was found.
+struct OperatingPoint {
+  Vector y0, yd0;
+  bool equilibrium = false;
+  int iterations = 0;
+  double residual_norm = 0;
+  std::string report;
+};
+
+/// Eigenvalues of λ²M + λQ + K (or λE − A), one per conjugate pair unless all.
+struct Modes {
+  Eigen::VectorXcd eigenvalues;  // 1/s
+  Vector natural_frequency_hz, damped_frequency_hz, damping_ratio, backward_error, error_bound;
+  std::vector<std::string> kinds;  // "finite", "zero", "infinite", "zero_within_bound"
+  Eigen::MatrixXcd shapes;         // column k: mode k's right eigenvector
+  std::string stability, method;
+};
+
+/// One input's response at one output over frequencies in Hz.
+struct Response {
+  Eigen::VectorXcd values;
+  Vector rcond;
+  std::vector<std::string> flags, warnings;
+  std::string method;
+};
+
+/// A model from a tape file (`mbsgen tape MODEL` prints the cached one's path).
+class Model {
+ public:
+  explicit Model(const std::string& tape_path);
+  ~Model();
+  Model(const Model&) = delete;
+  Model& operator=(const Model&) = delete;
+
+  std::string name() const;
+  std::string scene() const;
+  std::string evaluation() const;  // "tape"
+  std::vector<std::string> parameter_names() const;
+  std::vector<std::string> parameter_units() const;
+  Vector parameter_defaults() const;
+  std::vector<std::string> coordinate_names() const;
+  std::vector<std::string> coordinate_units() const;
+  std::vector<std::string> input_names() const;
+  std::vector<std::string> input_units() const;
+  std::vector<std::string> output_names() const;
+  std::vector<std::string> output_units() const;
+  bool descriptor() const;
+  /// The scene's frequency range and count (0, 0, 0: none given) and whether it is linear.
+  double default_from_hz() const;
+  double default_to_hz() const;
+  int default_points() const;
+
+  // Each analysis takes every parameter's value, in parameter_names()' order (DimensionError for
+  // another count, NonFiniteError for NaN or ∞, ParameterError for values no body has).
+  OperatingPoint operating_point(const ConstVectorRef& p) const;
+  Linear linear(const ConstVectorRef& p) const;
+  Modes modes(const ConstVectorRef& p, bool all) const;
+  /// input and output by name (NameError listing the known ones); method as `frf --method`.
+  Response frf(const ConstVectorRef& p, const std::string& input, const std::string& output,
+               const ConstVectorRef& hz, const std::string& method) const;
+  /// The outputs at the operating point.
+  Vector outputs(const ConstVectorRef& p) const;
+
+ private:
+  std::unique_ptr<TapeModel> tape_;
+};
+
+/// Modes of M ÿ + Q ẏ + K y = 0 given as matrices (Q may be 0×0: zero).
+Modes modes_of(const ConstMatrixRef& M, const ConstMatrixRef& Q, const ConstMatrixRef& K, bool all);
+/// The response of output row `output` to input column `input` (0-based) of
+/// M ÿ + Q ẏ + K y = B u, z = C_y y + C_v ẏ (C_v may be 0×0: zero), at frequencies in Hz.
+Response frf_of(const ConstMatrixRef& M, const ConstMatrixRef& Q, const ConstMatrixRef& K, const ConstMatrixRef& B,
+                const ConstMatrixRef& C_y, const ConstMatrixRef& C_v, Eigen::Index input, Eigen::Index output,
+                const ConstVectorRef& hz, const std::string& method);
+
+}  // namespace mbsgen::python

@@ -1,0 +1,112 @@
+// The extension module mbsgen._mbsgen (issue 41): pybind11 bindings of facade.hpp. The Python
+// layer (python/mbsgen/__init__.py) builds the public API on it: parameters by keyword, models by
+// path through the cache, result objects.
+#include <pybind11/complex.h>
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "facade.hpp"
+#include "mbsgen/runtime/error.hpp"
+#include "mbsgen/runtime/model/generated_model.hpp"
+#include "mbsgen/runtime/version.hpp"
+
+namespace py = pybind11;
+using namespace mbsgen::python;
+
+PYBIND11_MODULE(_mbsgen, m) {
+  m.doc() = "mbsgen's runtime from Python: models loaded from tapes, modes and frequency responses";
+  m.attr("__version__") = mbsgen::kRuntimeVersion;
+
+  // mbsgen::Error and its kinds. A bad value from the caller (an unknown name, a wrong size, a NaN,
+  // a negative mass) is a ValueError; the rest (a damaged tape, no equilibrium, LAPACK) an Error.
+  static py::exception<mbsgen::Error> error(m, "Error", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const mbsgen::NameError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const mbsgen::DimensionError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const mbsgen::NonFiniteError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const mbsgen::Error& e) {
+      error(e.what());
+    }
+  });
+
+  py::class_<Linear>(m, "Linear")
+      .def_readonly("descriptor", &Linear::descriptor)
+      .def_readonly("M", &Linear::M)
+      .def_readonly("Q", &Linear::Q)
+      .def_readonly("K", &Linear::K)
+      .def_readonly("B", &Linear::B)
+      .def_readonly("C_y", &Linear::C_y)
+      .def_readonly("C_v", &Linear::C_v)
+      .def_readonly("C_a", &Linear::C_a)
+      .def_readonly("D", &Linear::D)
+      .def_readonly("B1", &Linear::B1)
+      .def_readonly("B2", &Linear::B2)
+      .def_readonly("D1", &Linear::D1)
+      .def_readonly("E", &Linear::E)
+      .def_readonly("A", &Linear::A)
+      .def_readonly("C", &Linear::C)
+      .def_readonly("state_names", &Linear::state_names);
+
+  py::class_<OperatingPoint>(m, "OperatingPoint")
+      .def_readonly("y0", &OperatingPoint::y0)
+      .def_readonly("yd0", &OperatingPoint::yd0)
+      .def_readonly("equilibrium", &OperatingPoint::equilibrium)
+      .def_readonly("iterations", &OperatingPoint::iterations)
+      .def_readonly("residual_norm", &OperatingPoint::residual_norm)
+      .def_readonly("report", &OperatingPoint::report);
+
+  py::class_<Modes>(m, "Modes")
+      .def_readonly("eigenvalues", &Modes::eigenvalues)
+      .def_readonly("natural_frequency_hz", &Modes::natural_frequency_hz)
+      .def_readonly("damped_frequency_hz", &Modes::damped_frequency_hz)
+      .def_readonly("damping_ratio", &Modes::damping_ratio)
+      .def_readonly("backward_error", &Modes::backward_error)
+      .def_readonly("error_bound", &Modes::error_bound)
+      .def_readonly("kinds", &Modes::kinds)
+      .def_readonly("shapes", &Modes::shapes)
+      .def_readonly("stability", &Modes::stability)
+      .def_readonly("method", &Modes::method);
+
+  py::class_<Response>(m, "Response")
+      .def_readonly("values", &Response::values)
+      .def_readonly("rcond", &Response::rcond)
+      .def_readonly("flags", &Response::flags)
+      .def_readonly("warnings", &Response::warnings)
+      .def_readonly("method", &Response::method);
+
+  const auto released = py::call_guard<py::gil_scoped_release>();
+  py::class_<Model>(m, "TapeModel")
+      .def(py::init<const std::string&>(), py::arg("path"), released)
+      .def_property_readonly("name", &Model::name)
+      .def_property_readonly("scene", &Model::scene)
+      .def_property_readonly("evaluation", &Model::evaluation)
+      .def_property_readonly("parameter_names", &Model::parameter_names)
+      .def_property_readonly("parameter_units", &Model::parameter_units)
+      .def_property_readonly("parameter_defaults", &Model::parameter_defaults)
+      .def_property_readonly("coordinate_names", &Model::coordinate_names)
+      .def_property_readonly("coordinate_units", &Model::coordinate_units)
+      .def_property_readonly("input_names", &Model::input_names)
+      .def_property_readonly("input_units", &Model::input_units)
+      .def_property_readonly("output_names", &Model::output_names)
+      .def_property_readonly("output_units", &Model::output_units)
+      .def_property_readonly("descriptor", &Model::descriptor)
+      .def_property_readonly("default_from_hz", &Model::default_from_hz)
+      .def_property_readonly("default_to_hz", &Model::default_to_hz)
+      .def_property_readonly("default_points", &Model::default_points)
+      .def("operating_point", &Model::operating_point, py::arg("p"), released)
+      .def("linear", &Model::linear, py::arg("p"), released)
+      .def("modes", &Model::modes, py::arg("p"), py::arg("all") = false, released)
+      .def("frf", &Model::frf, py::arg("p"), py::arg("input"), py::arg("output"), py::arg("hz"),
+           py::arg("method") = "auto", released)
+      .def("outputs", &Model::outputs, py::arg("p"), released);
+
+  m.def("modes_of", &modes_of, py::arg("M"), py::arg("Q"), py::arg("K"), py::arg("all") = false, released);
+  m.def("frf_of", &frf_of, py::arg("M"), py::arg("Q"), py::arg("K"), py::arg("B"), py::arg("C_y"), py::arg("C_v"),
+        py::arg("input"), py::arg("output"), py::arg("hz"), py::arg("method") = "auto", released);
+}
