@@ -42,10 +42,12 @@ def tool() -> str:
     given = os.environ.get("MBSGEN")
     if given:
         return given
-    recorded = os.path.join(os.path.dirname(__file__), "tool_path.txt")
+    here = os.path.dirname(os.path.abspath(__file__))
     try:
-        with open(recorded, encoding="utf-8") as f:
+        with open(os.path.join(here, "tool_path.txt"), encoding="utf-8") as f:
             path = f.read().strip()
+        if path and not os.path.isabs(path):  # installed: relative to the package
+            path = os.path.normpath(os.path.join(here, path))
         if path and os.access(path, os.X_OK):
             return path
     except OSError:

@@ -1,0 +1,206 @@
+"""The Python package against the command line and against closed forms (issue 41 §3).
+
+Run by ctest (tests/python/CMakeLists.txt) with PYTHONPATH at the build tree's package, MBSGEN at
+the build's mbsgen command and MBSGEN_SOURCE_DIR at the repository. The package and `mbsgen run`
+evaluate the same tape with the same runtime code, so their numbers must be equal bit for bit: the
+command line prints 17 significant digits, which read back to the same double.
+"""
+
+import json
+import os
+import resource
+import subprocess
+
+import numpy as np
+import pytest
+
+import mbsgen
+
+SOURCE = os.environ["MBSGEN_SOURCE_DIR"]
+TOOL = os.environ["MBSGEN"]
+
+
+def shipped_models():
+    """(model file, scene) of generated/models.txt, each once."""
+    seen = []
+    with open(os.path.join(SOURCE, "generated", "models.txt"), encoding="utf-8") as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            _, path, scene = line.split()[:3]
+            if (path, scene) not in seen:
+                seen.append((path, scene))
+    return seen
+
+
+# Closed loops have no tape (their kernels close the loops by Newton in compiled code only).
+CLOSED_LOOPS = {"models/linkages/four_bar.yaml", "models/bicycle/whipple_benchmark.yaml"}
+# A scene for simulation only, without the linear kernel.
+NO_LINEAR = {("models/textbook/rotor_disk.yaml", "motion")}
+TAPED = [m for m in shipped_models() if m[0] not in CLOSED_LOOPS and m not in NO_LINEAR]
+
+
+def cli(path, scene, *args):
+    done = subprocess.run([TOOL, "run", os.path.join(SOURCE, path), "--scene", scene, "--", *args],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+_models = {}
+
+
+def model(path, scene):
+    key = (path, scene)
+    if key not in _models:
+        _models[key] = mbsgen.Model(os.path.join(SOURCE, path), scene=scene)
+    return _models[key]
+
+
+def one_changed_parameter(m):
+    """A parameter set 10 % above its default (the first nonzero one), as keyword and as --set."""
+    for p in m.parameters:
+        if p.default != 0:
+            value = p.default * 1.1
+            return {p.name: value}, ["--set", f"{p.name}={value!r}"]
+    return {}, []
+
+
+@pytest.mark.parametrize("path,scene", TAPED, ids=[f"{os.path.basename(p)}:{s}" for p, s in TAPED])
+class TestAgainstTheCommandLine:
+    def test_names(self, path, scene):
+        m = model(path, scene)
+        j = cli(path, scene, "matrices", "--format", "json")
+        assert m.inputs == j["inputs"] and m.outputs == j["outputs"]
+        assert (m.coordinates == j["coordinates"]) if "coordinates" in j else True
+
+    def test_matrices(self, path, scene):
+        m = model(path, scene)
+        params, set_args = one_changed_parameter(m)
+        for kwargs, extra in (({}, []), (params, set_args)):
+            j = cli(path, scene, "matrices", "--format", "json", *extra)
+            lin = m.linear(**kwargs)
+            names = ["E", "A", "B", "C"] if lin.descriptor else ["M", "Q", "K", "B", "C_y", "C_v"]
+            for name in names:
+                expected = np.array(j[name], dtype=float).reshape(getattr(lin, name).shape)
+                assert np.array_equal(getattr(lin, name), expected), name
+
+    def test_modes(self, path, scene):
+        m = model(path, scene)
+        params, set_args = one_changed_parameter(m)
+        for kwargs, extra in (({}, []), (params, set_args)):
+            j = cli(path, scene, "modes", "--format", "json", *extra)
+            r = m.modes(**kwargs)
+            assert r.stability == j["stability"]
+            assert len(r.eigenvalues) == len(j["modes"])
+            for k, mode in enumerate(j["modes"]):
+                lam = complex(float(mode["lambda_re"]), float(mode["lambda_im"]))
+                assert r.eigenvalues[k] == lam or (np.isinf(lam.real) and np.isinf(r.eigenvalues[k].real))
+                assert r.error_bound[k] == float(mode["error_bound"])
+                assert r.kinds[k] == mode["kind"]
+
+    def test_frf(self, path, scene):
+        m = model(path, scene)
+        if not m.inputs or not m.outputs:
+            pytest.skip("no input or no output")
+        j = cli(path, scene, "frf", "--input", m.inputs[0], "--output", m.outputs[-1], "--from", "0.5", "--to",
+                "2000", "--points", "7", "--format", "json")
+        hz = np.array([float(p["frequency_hz"]) for p in j["points"]])
+        r = m.frf(m.inputs[0], m.outputs[-1], hz)
+        expected = np.array([complex(float(p["re"]), float(p["im"])) for p in j["points"]])
+        assert np.array_equal(r.values, expected)
+        assert r.flags == [p["flag"] for p in j["points"]]
+
+
+class TestClosedForms:
+    def test_two_masses_on_springs(self):
+        # m1 = 1, m2 = 2, k1 = 3 (to the ground), k2 = 4 (between): ω² are the roots of
+        # m1 m2 ω⁴ − (m1 k2 + m2 (k1 + k2)) ω² + k1 k2 = 0.
+        M = np.diag([1.0, 2.0])
+        K = np.array([[7.0, -4.0], [-4.0, 4.0]])
+        w2 = np.sort(np.roots([2.0, -(1.0 * 4.0 + 2.0 * 7.0), 12.0]).real)
+        r = mbsgen.linear.modes(M, None, K)
+        assert np.allclose(np.sort(np.abs(r.eigenvalues)), np.sqrt(w2), rtol=1e-14, atol=0)
+        # the bound the solver states holds for the closed form
+        assert np.all(np.abs(np.sort(np.abs(r.eigenvalues)) - np.sqrt(w2)) <= r.error_bound + 1e-15)
+        assert r.stability == "marginal"
+
+    def test_damped_oscillator_response(self):
+        # m ÿ + c ẏ + k y = u: H(Ω) = 1 / (k − mΩ² + icΩ), rounding of a few operations.
+        m, c, k = 2.0, 0.3, 50.0
+        hz = np.array([0.0, 0.5, 0.8, 10.0])
+        r = mbsgen.linear.frf([[m]], [[c]], [[k]], [[1.0]], [[1.0]], hz)
+        w = 2 * np.pi * hz
+        assert np.allclose(r.values, 1 / (k - m * w**2 + 1j * c * w), rtol=1e-14, atol=0)
+        assert r.flags == ["ok"] * 4
+
+
+class TestErrors:
+    def test_unknown_parameter(self):
+        m = model("models/textbook/double_pendulum.yaml", "full")
+        with pytest.raises(ValueError, match="no parameter 'mass'.*m1, m2"):
+            m.modes(mass=1.0)
+
+    def test_unphysical_and_non_finite_values(self):
+        m = model("models/textbook/double_pendulum.yaml", "full")
+        with pytest.raises(ValueError, match="mass -1 kg"):
+            m.linear(m1=-1.0)
+        with pytest.raises(ValueError, match="non-finite"):
+            m.linear(m1=float("nan"))
+
+    def test_unknown_input_and_bad_frequencies(self):
+        m = model("models/textbook/double_pendulum.yaml", "full")
+        with pytest.raises(ValueError, match="force"):
+            m.frf("force", "tip_x", [1.0])
+        with pytest.raises(ValueError, match="frequencies"):
+            m.frf("F", "tip_x", [[1.0, 2.0]])
+        with pytest.raises(ValueError, match="frequencies"):
+            m.frf("F", "tip_x", [-1.0])
+
+    def test_shapes_of_matrices(self):
+        with pytest.raises(ValueError, match=r"K: shape \(3, 3\), expected \(2, 2\)"):
+            mbsgen.linear.modes(np.eye(2), None, np.eye(3))
+        with pytest.raises(ValueError, match="input: 1 is not a column of B"):
+            mbsgen.linear.frf(np.eye(2), None, np.eye(2), np.ones((2, 1)), np.eye(2), [1.0], input=1)
+
+    def test_bad_model_file(self, tmp_path):
+        bad = tmp_path / "bad.yaml"
+        bad.write_text("model: m\nbodies:\n  - name: [\n")
+        with pytest.raises(mbsgen.ModelError, match=r"bad\.yaml:\d+:\d+"):
+            mbsgen.Model(bad)
+
+    def test_a_scene_without_linear_analyses(self):
+        m = model("models/textbook/rotor_disk.yaml", "motion")
+        with pytest.raises(mbsgen.Error, match="no linear kernel"):
+            m.modes()
+
+    def test_closed_loops_have_no_tape(self):
+        with pytest.raises(mbsgen.ModelError, match="closed loops"):
+            mbsgen.Model(os.path.join(SOURCE, "models/linkages/four_bar.yaml"))
+
+
+def test_a_tape_file_directly(tmp_path):
+    out = tmp_path / "gen"
+    subprocess.run([TOOL, "generate", os.path.join(SOURCE, "models/textbook/simple_pendulum.yaml"), "--tape",
+                    "--out", str(out)], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    tapes = list(out.glob("*.tape"))
+    assert len(tapes) == 1
+    direct = mbsgen.Model(tapes[0])
+    cached = model("models/textbook/simple_pendulum.yaml", "full")
+    assert np.array_equal(direct.modes().eigenvalues, cached.modes().eigenvalues)
+
+
+def resident_kib():
+    with open("/proc/self/statm", encoding="ascii") as f:
+        return int(f.read().split()[1]) * resource.getpagesize() // 1024
+
+
+def test_no_memory_is_kept_per_call():
+    # 10⁵ calls after 10⁴ to warm up: a leak of 50 bytes a call would keep 5 MB.
+    m = model("models/textbook/double_pendulum.yaml", "full")
+    for _ in range(10_000):
+        m.linear(m1=1.5)
+    before = resident_kib()
+    for _ in range(100_000):
+        m.linear(m1=1.5)
+    assert resident_kib() - before < 4096
