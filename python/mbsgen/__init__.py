@@ -22,7 +22,7 @@ import numpy as np
 from . import _mbsgen
 from ._mbsgen import Error
 
-__all__ = ["Model", "Parameter", "Error", "ModelError", "linear", "tool"]
+__all__ = ["Model", "Parameter", "Modes", "Response", "BatchResponse", "Error", "ModelError", "linear", "tool"]
 __version__ = _mbsgen.__version__
 
 
@@ -101,6 +101,15 @@ class Response(NamedTuple):
     method: str
 
 
+class BatchResponse(NamedTuple):
+    """Frequency responses of many parameter sets: values[k] for set k (NaN where it failed);
+    failures: (set index, reason) of each failed set."""
+
+    frequencies_hz: np.ndarray
+    values: np.ndarray
+    failures: List[tuple]
+
+
 def _modes(m) -> Modes:
     return Modes(m.eigenvalues, m.natural_frequency_hz, m.damped_frequency_hz, m.damping_ratio, m.backward_error,
                  m.error_bound, list(m.kinds), m.shapes, m.stability, m.method)
@@ -175,13 +184,45 @@ class Model:
         """The eigenvalues of the linear model (see Modes)."""
         return _modes(self._tape.modes(self.parameter_values(**params), all))
 
-    def frf(self, input: str, output: str, frequencies: Sequence[float], method: str = "auto",
-            **params: float) -> Response:
+    def frf(self, input: str, output: str, frequencies: Sequence[float], method: str = "auto", params=None,
+            threads: int = 0, **values: float):
         """The response of `output` to a harmonic `input` of unit amplitude at `frequencies` (Hz).
-        method: auto, direct, banded, hessenberg, modal or real (as `frf --method`)."""
+        method: auto, direct, banded, hessenberg, modal or real (as `frf --method`).
+
+        With params, one response per parameter set, on `threads` threads (0: one per core) with
+        the GIL released: params is an array of shape (n_sets, len(parameters)) in the model's
+        parameter order, or a dict {name: array of n_sets values} (the others at their defaults or
+        as given by keyword). Returns a BatchResponse."""
         hz = _frequencies(frequencies)
-        r = self._tape.frf(self.parameter_values(**params), input, output, hz, method)
-        return Response(hz, r.values, r.rcond, list(r.flags), list(r.warnings), r.method)
+        if params is None:
+            r = self._tape.frf(self.parameter_values(**values), input, output, hz, method)
+            return Response(hz, r.values, r.rcond, list(r.flags), list(r.warnings), r.method)
+        b = self._tape.frf_batch(self.parameter_sets(params, **values), input, output, hz, method, int(threads))
+        return BatchResponse(hz, b.values, list(zip(b.failed, b.reasons)))
+
+    def parameter_sets(self, params, **values: float) -> np.ndarray:
+        """params (an array of shape (n_sets, len(parameters)), or a dict {name: n_sets values}) as
+        an array of every parameter's value per set."""
+        n_params = len(self.parameters)
+        if isinstance(params, dict):
+            lengths = {name: np.size(v) for name, v in params.items()}
+            if len(set(lengths.values())) != 1:
+                raise ValueError(f"params: every parameter needs as many values ({lengths})")
+            n = next(iter(lengths.values()))
+            sets = np.tile(self.parameter_values(**values), (n, 1))
+            for name, v in params.items():
+                if name not in self._index:
+                    raise ValueError(f"model {self.name!r} has no parameter {name!r} "
+                                     f"(parameters: {', '.join(self._index)})")
+                sets[:, self._index[name]] = np.asarray(v, dtype=np.float64).reshape(n)
+            return sets
+        sets = np.ascontiguousarray(params, dtype=np.float64)
+        if sets.ndim != 2 or sets.shape[1] != n_params:
+            raise ValueError(f"params: shape {sets.shape}, expected (n_sets, {n_params}) "
+                             f"(every parameter of model {self.name!r}, in order)")
+        if values:
+            raise ValueError("params: give the values either in params or by keyword, not both")
+        return sets
 
     def output_values(self, **params: float) -> np.ndarray:
         """The outputs at the operating point."""

@@ -9,7 +9,16 @@
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <exception>
+#include <limits>
+#include <thread>
+
+// OpenBLAS's own threads would compete with the batch's (and its results depend on their count):
+// one thread, as the study sets it, when OpenBLAS is the BLAS.
+extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 
 namespace mbsgen::python {
 
@@ -177,6 +186,48 @@ Response Model::frf(const ConstVectorRef& p, const std::string& input, const std
   }
   const LinearModel lin = model.linear_model();
   return second_order_response(lin, in, out, hz, method);
+}
+
+BatchResponse Model::frf_batch(const ConstRowMajorRef& sets, const std::string& input, const std::string& output,
+                               const ConstVectorRef& hz, const std::string& method, int threads) const {
+  const Eigen::Index n = sets.rows();
+  if (sets.cols() != tape_->kernels().n_parameters)
+    throw DimensionError("frf_batch: the parameter sets have " + std::to_string(sets.cols()) + " columns, the model " +
+                         std::to_string(tape_->kernels().n_parameters) + " parameters");
+  {  // names and the method checked once, before any thread starts
+    const GeneratedModel model(tape_->kernels());
+    (void)model.input_index(input);
+    (void)model.output_index(output);
+    parse_frf_method(method);
+  }
+  BatchResponse r;
+  r.values.setConstant(n, hz.size(), std::complex<double>(std::nan(""), std::nan("")));
+  std::vector<std::string> reason(static_cast<std::size_t>(n));
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int workers = static_cast<int>(std::min<Eigen::Index>(threads > 0 ? threads : cores, std::max<Eigen::Index>(n, 1)));
+  if (openblas_set_num_threads) openblas_set_num_threads(1);
+  std::atomic<Eigen::Index> next{0};
+  auto work = [&] {
+    for (Eigen::Index k = next++; k < n; k = next++) {
+      try {
+        const Vector p = sets.row(k).transpose();
+        r.values.row(k) = frf(p, input, output, hz, method).values.transpose();
+      } catch (const std::exception& e) {
+        r.values.row(k).setConstant(std::complex<double>(std::nan(""), std::nan("")));
+        reason[static_cast<std::size_t>(k)] = e.what();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < workers; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  for (Eigen::Index k = 0; k < n; ++k)
+    if (!reason[static_cast<std::size_t>(k)].empty()) {
+      r.failed.push_back(static_cast<long>(k));
+      r.reasons.push_back(std::move(reason[static_cast<std::size_t>(k)]));
+    }
+  return r;
 }
 
 Vector Model::outputs(const ConstVectorRef& p) const {

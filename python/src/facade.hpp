@@ -60,6 +60,15 @@ struct Response {
   std::string method;
 };
 
+/// One response per parameter set: row k of values for set k, NaN where the set failed.
+struct BatchResponse {
+  Eigen::MatrixXcd values;
+  std::vector<long> failed;          // the sets that failed, in order
+  std::vector<std::string> reasons;  // why, one per failed set
+};
+
+using ConstRowMajorRef = Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+
 /// A model from a tape file (`mbsgen tape MODEL` prints the cached one's path).
 class Model {
  public:
@@ -94,6 +103,11 @@ class Model {
   /// input and output by name (NameError listing the known ones); method as `frf --method`.
   Response frf(const ConstVectorRef& p, const std::string& input, const std::string& output,
                const ConstVectorRef& hz, const std::string& method) const;
+  /// frf for each row of sets (every parameter, in order), on `threads` threads (0: one per
+  /// core). A set that fails (a negative mass, no equilibrium) leaves a row of NaN and its reason;
+  /// the others are what frf gives for them, bit for bit.
+  BatchResponse frf_batch(const ConstRowMajorRef& sets, const std::string& input, const std::string& output,
+                          const ConstVectorRef& hz, const std::string& method, int threads) const;
   /// The outputs at the operating point.
   Vector outputs(const ConstVectorRef& p) const;
 

@@ -80,6 +80,11 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def_readonly("warnings", &Response::warnings)
       .def_readonly("method", &Response::method);
 
+  py::class_<BatchResponse>(m, "BatchResponse")
+      .def_readonly("values", &BatchResponse::values)
+      .def_readonly("failed", &BatchResponse::failed)
+      .def_readonly("reasons", &BatchResponse::reasons);
+
   const auto released = py::call_guard<py::gil_scoped_release>();
   py::class_<Model>(m, "TapeModel")
       .def(py::init<const std::string&>(), py::arg("path"), released)
@@ -104,6 +109,8 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def("modes", &Model::modes, py::arg("p"), py::arg("all") = false, released)
       .def("frf", &Model::frf, py::arg("p"), py::arg("input"), py::arg("output"), py::arg("hz"),
            py::arg("method") = "auto", released)
+      .def("frf_batch", &Model::frf_batch, py::arg("sets"), py::arg("input"), py::arg("output"), py::arg("hz"),
+           py::arg("method") = "auto", py::arg("threads") = 0, released)
       .def("outputs", &Model::outputs, py::arg("p"), released);
 
   m.def("modes_of", &modes_of, py::arg("M"), py::arg("Q"), py::arg("K"), py::arg("all") = false, released);

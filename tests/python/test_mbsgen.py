@@ -204,3 +204,31 @@ def test_no_memory_is_kept_per_call():
     for _ in range(100_000):
         m.linear(m1=1.5)
     assert resident_kib() - before < 4096
+
+
+class TestBatch:
+    def test_rows_are_the_single_responses_on_any_number_of_threads(self):
+        m = model("models/middle_ear/middle_ear.yaml", "full")
+        hz = np.logspace(2, 4, 40)
+        rng = np.random.default_rng(7)
+        names = ["m_stapes", "k_al_z"]
+        defaults = m.parameter_values()
+        columns = {n: defaults[[p.name for p in m.parameters].index(n)] * rng.uniform(0.8, 1.2, 12) for n in names}
+        columns["m_stapes"][3] = -1e-6  # a negative mass: refused for this set only
+        one = m.frf("P", "v_stapes", hz, params=columns, threads=1)
+        two = m.frf("P", "v_stapes", hz, params=columns, threads=2)
+        assert np.array_equal(one.values, two.values, equal_nan=True)
+        assert [k for k, _ in one.failures] == [3] and names[0] in one.failures[0][1]
+        assert np.all(np.isnan(one.values[3]))
+        for k in (0, 5, 11):
+            single = m.frf("P", "v_stapes", hz, **{n: columns[n][k] for n in names})
+            assert np.array_equal(one.values[k], single.values)
+
+    def test_bad_sets(self):
+        m = model("models/textbook/double_pendulum.yaml", "full")
+        with pytest.raises(ValueError, match=r"params: shape \(3, 4\), expected \(n_sets, 5\)"):
+            m.frf("F", "tip_x", [1.0], params=np.ones((3, 4)))
+        with pytest.raises(ValueError, match="as many values"):
+            m.frf("F", "tip_x", [1.0], params={"m1": [1.0, 2.0], "m2": [1.0]})
+        with pytest.raises(ValueError, match="force"):
+            m.frf("force", "tip_x", [1.0], params={"m1": [1.0]})
