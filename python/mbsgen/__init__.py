@@ -139,6 +139,7 @@ class Model:
         self._index: Dict[str, int] = {n: i for i, n in enumerate(names)}
         self.parameters: List[Parameter] = [
             Parameter(n, float(d), u) for n, d, u in zip(names, self._tape.parameter_defaults, self._tape.parameter_units)]
+        self._defaults = np.array([q.default for q in self.parameters], dtype=np.float64)
         self.coordinates: List[str] = list(self._tape.coordinate_names)
         self.coordinate_units: List[str] = list(self._tape.coordinate_units)
         self.inputs: List[str] = list(self._tape.input_names)
@@ -155,7 +156,7 @@ class Model:
 
     def parameter_values(self, **params: float) -> np.ndarray:
         """Every parameter's value in the model's order: the defaults, with the given ones set."""
-        p = np.array([q.default for q in self.parameters], dtype=np.float64)
+        p = self._defaults.copy()
         for name, value in params.items():
             i = self._index.get(name)
             if i is None:

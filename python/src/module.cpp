@@ -6,6 +6,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <chrono>
+
 #include "facade.hpp"
 #include "mbsgen/runtime/error.hpp"
 #include "mbsgen/runtime/model/generated_model.hpp"
@@ -112,6 +114,25 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def("frf_batch", &Model::frf_batch, py::arg("sets"), py::arg("input"), py::arg("output"), py::arg("hz"),
            py::arg("method") = "auto", py::arg("threads") = 0, released)
       .def("outputs", &Model::outputs, py::arg("p"), released);
+
+  // For bench/python_bench.py: the same facade calls timed in C++ (n calls in a row, seconds in
+  // all), so that the Python overhead per call is a difference measured in one process.
+  auto timing = m.def_submodule("_timing", "the facade's calls timed in C++ (bench/python_bench.py)");
+  timing.def(
+      "linear", [](const Model& model, const Vector& p, int n) {
+        const auto t0 = std::chrono::steady_clock::now();
+        for (int k = 0; k < n; ++k) (void)model.linear(p);
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      },
+      py::arg("model"), py::arg("p"), py::arg("n"), released);
+  timing.def(
+      "frf", [](const Model& model, const Vector& p, const std::string& input, const std::string& output,
+                const Vector& hz, int n) {
+        const auto t0 = std::chrono::steady_clock::now();
+        for (int k = 0; k < n; ++k) (void)model.frf(p, input, output, hz, "auto");
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      },
+      py::arg("model"), py::arg("p"), py::arg("input"), py::arg("output"), py::arg("hz"), py::arg("n"), released);
 
   m.def("modes_of", &modes_of, py::arg("M"), py::arg("Q"), py::arg("K"), py::arg("all") = false, released);
   m.def("frf_of", &frf_of, py::arg("M"), py::arg("Q"), py::arg("K"), py::arg("B"), py::arg("C_y"), py::arg("C_v"),
