@@ -189,7 +189,8 @@ Response Model::frf(const ConstVectorRef& p, const std::string& input, const std
 }
 
 BatchResponse Model::frf_batch(const ConstRowMajorRef& sets, const std::string& input, const std::string& output,
-                               const ConstVectorRef& hz, const std::string& method, int threads) const {
+                               const ConstVectorRef& hz, const std::string& method, int threads,
+                               const std::function<bool()>& stop) const {
   const Eigen::Index n = sets.rows();
   if (sets.cols() != tape_->kernels().n_parameters)
     throw DimensionError("frf_batch: the parameter sets have " + std::to_string(sets.cols()) + " columns, the model " +
@@ -207,8 +208,9 @@ BatchResponse Model::frf_batch(const ConstRowMajorRef& sets, const std::string& 
   const int workers = static_cast<int>(std::min<Eigen::Index>(threads > 0 ? threads : cores, std::max<Eigen::Index>(n, 1)));
   if (openblas_set_num_threads) openblas_set_num_threads(1);
   std::atomic<Eigen::Index> next{0};
-  auto work = [&] {
-    for (Eigen::Index k = next++; k < n; k = next++) {
+  std::atomic<bool> stopped{false};
+  auto work = [&](bool asks) {
+    for (Eigen::Index k = next++; k < n && !stopped; k = next++) {
       try {
         const Vector p = sets.row(k).transpose();
         r.values.row(k) = frf(p, input, output, hz, method).values.transpose();
@@ -216,12 +218,14 @@ BatchResponse Model::frf_batch(const ConstRowMajorRef& sets, const std::string& 
         r.values.row(k).setConstant(std::complex<double>(std::nan(""), std::nan("")));
         reason[static_cast<std::size_t>(k)] = e.what();
       }
+      if (asks && stop && stop()) stopped = true;
     }
   };
   std::vector<std::thread> pool;
-  for (int t = 1; t < workers; ++t) pool.emplace_back(work);
-  work();
+  for (int t = 1; t < workers; ++t) pool.emplace_back(work, false);
+  work(true);
   for (std::thread& t : pool) t.join();
+  if (stopped) throw Stopped();
   for (Eigen::Index k = 0; k < n; ++k)
     if (!reason[static_cast<std::size_t>(k)].empty()) {
       r.failed.push_back(static_cast<long>(k));

@@ -9,7 +9,9 @@
 
 #include <Eigen/Dense>
 
+#include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -69,6 +71,13 @@ struct BatchResponse {
 
 using ConstRowMajorRef = Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
 
+/// Thrown by a long computation that `stop` ended (the binding turns it into the Python
+/// exception that stop found pending, such as KeyboardInterrupt).
+class Stopped : public std::runtime_error {
+ public:
+  Stopped() : std::runtime_error("stopped") {}
+};
+
 /// A model from a tape file (`mbsgen tape MODEL` prints the cached one's path).
 class Model {
  public:
@@ -105,9 +114,12 @@ class Model {
                const ConstVectorRef& hz, const std::string& method) const;
   /// frf for each row of sets (every parameter, in order), on `threads` threads (0: one per
   /// core). A set that fails (a negative mass, no equilibrium) leaves a row of NaN and its reason;
-  /// the others are what frf gives for them, bit for bit.
+  /// the others are what frf gives for them, bit for bit. stop (may be empty) is asked after each
+  /// set the calling thread computes; when it says true, the threads finish their sets and
+  /// Stopped is thrown.
   BatchResponse frf_batch(const ConstRowMajorRef& sets, const std::string& input, const std::string& output,
-                          const ConstVectorRef& hz, const std::string& method, int threads) const;
+                          const ConstVectorRef& hz, const std::string& method, int threads,
+                          const std::function<bool()>& stop = {}) const;
   /// The outputs at the operating point.
   Vector outputs(const ConstVectorRef& p) const;
 

@@ -111,8 +111,24 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def("modes", &Model::modes, py::arg("p"), py::arg("all") = false, released)
       .def("frf", &Model::frf, py::arg("p"), py::arg("input"), py::arg("output"), py::arg("hz"),
            py::arg("method") = "auto", released)
-      .def("frf_batch", &Model::frf_batch, py::arg("sets"), py::arg("input"), py::arg("output"), py::arg("hz"),
-           py::arg("method") = "auto", py::arg("threads") = 0, released)
+      .def(
+          "frf_batch",
+          [](const Model& model, const ConstRowMajorRef& sets, const std::string& input, const std::string& output,
+             const ConstVectorRef& hz, const std::string& method, int threads) {
+            // Ctrl-C: the calling thread looks for a pending signal after each of its sets.
+            const auto interrupted = [] {
+              py::gil_scoped_acquire gil;
+              return PyErr_CheckSignals() != 0;
+            };
+            try {
+              return model.frf_batch(sets, input, output, hz, method, threads, interrupted);
+            } catch (const Stopped&) {
+              py::gil_scoped_acquire gil;
+              throw py::error_already_set();  // the KeyboardInterrupt (or other) PyErr_CheckSignals set
+            }
+          },
+          py::arg("sets"), py::arg("input"), py::arg("output"), py::arg("hz"), py::arg("method") = "auto",
+          py::arg("threads") = 0, released)
       .def("outputs", &Model::outputs, py::arg("p"), released);
 
   // For bench/python_bench.py: the same facade calls timed in C++ (n calls in a row, seconds in

@@ -232,3 +232,20 @@ class TestBatch:
             m.frf("F", "tip_x", [1.0], params={"m1": [1.0, 2.0], "m2": [1.0]})
         with pytest.raises(ValueError, match="force"):
             m.frf("force", "tip_x", [1.0], params={"m1": [1.0]})
+
+    def test_ctrl_c_stops_a_long_batch(self):
+        # 20,000 sets of the middle ear at 300 frequencies take about a minute on 2 cores; SIGINT
+        # after 0.5 s must end the call with KeyboardInterrupt within a few sets.
+        import signal
+        import threading
+        import time
+
+        m = model("models/middle_ear/middle_ear.yaml", "full")
+        sets = np.tile(m.parameter_values(), (20_000, 1))
+        timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+        t0 = time.perf_counter()
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            m.frf("P", "v_stapes", np.logspace(2, 4, 300), params=sets)
+        timer.join()
+        assert time.perf_counter() - t0 < 10
