@@ -201,6 +201,21 @@ class Model:
         b = self._tape.frf_batch(self.parameter_sets(params, **values), input, output, hz, method, int(threads))
         return BatchResponse(hz, b.values, list(zip(b.failed, b.reasons)))
 
+    def modes_sensitivity(self, parameters: Optional[Sequence[str]] = None, **values: float):
+        """dλ/dp of every eigenvalue (both members of each conjugate pair) by the named parameters
+        (all when None): exact, by forward mode over the tape. Returns an object with modes,
+        parameters, parameter_values, dlambda (modes × parameters, 1/s per unit), dfrequency_hz,
+        relative_frequency ((p/f) df/dp), ddamping_ratio, and notes (why a mode's derivative is
+        not defined: repeated, defective, zero, infinite; its entries are NaN)."""
+        return self._tape.modes_sensitivity(self.parameter_values(**values), list(parameters or []))
+
+    def frf_sensitivity(self, input: str, output: str, frequencies: Sequence[float],
+                        parameters: Optional[Sequence[str]] = None, **values: float):
+        """The response and dz/dp by the named parameters (all when None) at `frequencies` (Hz):
+        values, derivatives (parameters × frequencies), rcond, parameters, parameter_values."""
+        hz = _frequencies(frequencies)
+        return self._tape.frf_sensitivity(self.parameter_values(**values), input, output, hz, list(parameters or []))
+
     def parameter_sets(self, params, **values: float) -> np.ndarray:
         """params (an array of shape (n_sets, len(parameters)), or a dict {name: n_sets values}) as
         an array of every parameter's value per set."""

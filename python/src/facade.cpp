@@ -8,6 +8,7 @@
 #include "mbsgen/runtime/spectral/descriptor_eigen.hpp"
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
+#include "mbsgen/runtime/spectral/sensitivity.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -186,6 +187,83 @@ Response Model::frf(const ConstVectorRef& p, const std::string& input, const std
   }
   const LinearModel lin = model.linear_model();
   return second_order_response(lin, in, out, hz, method);
+}
+
+namespace {
+
+void refuse_descriptor(const GeneratedModel& model, const char* what) {
+  if (model.is_descriptor())
+    throw Error(std::string(what) + ": model '" + model.kernels().model +
+                "' has rolling constraints; sensitivities are not available for it");
+}
+
+}  // namespace
+
+ModeSensitivities Model::modes_sensitivity(const ConstVectorRef& p, const std::vector<std::string>& names) const {
+  const GeneratedModel model = configured(*tape_, p);
+  refuse_descriptor(model, "modes_sensitivity");
+  const mbsgen::OperatingPoint op = model.operating_point();
+  const LinearModel lin = model.linear_model(op);
+  const std::vector<MatrixSensitivity> d = model.linear_sensitivities(op, names);
+  QuadraticEigenOptions opt;
+  opt.one_per_conjugate_pair = false;  // the separation test needs every eigenvalue
+  QuadraticEigenSolver solver(lin.size(), opt);
+  solver.compute(lin);
+  const auto s = eigenvalue_sensitivities(lin, solver.modes(), d);
+  ModeSensitivities r;
+  r.modes = modes_from(solver.modes(), solver.stability(), solver.method(), lin.size());
+  const Eigen::Index n = static_cast<Eigen::Index>(s.size()), q = static_cast<Eigen::Index>(d.size());
+  r.parameter_values.resize(q);
+  for (Eigen::Index j = 0; j < q; ++j) {
+    r.parameters.push_back(d[static_cast<std::size_t>(j)].parameter);
+    r.parameter_values[j] = d[static_cast<std::size_t>(j)].value;
+  }
+  r.dlambda.resize(n, q);
+  r.dfrequency_hz.resize(n, q);
+  r.relative_frequency.resize(n, q);
+  r.ddamping_ratio.resize(n, q);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    std::string note;
+    for (Eigen::Index j = 0; j < q; ++j) {
+      const EigenvalueSensitivity& e = s[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)];
+      r.dlambda(k, j) = e.defined ? e.dlambda : std::complex<double>(nan, nan);
+      r.dfrequency_hz(k, j) = e.defined ? e.dfrequency_hz : nan;
+      r.relative_frequency(k, j) = e.defined ? e.relative_frequency : nan;
+      r.ddamping_ratio(k, j) = e.defined ? e.ddamping_ratio : nan;
+      if (!e.defined) note = e.note;
+    }
+    r.notes.push_back(note);
+  }
+  return r;
+}
+
+ResponseSensitivity Model::frf_sensitivity(const ConstVectorRef& p, const std::string& input, const std::string& output,
+                                           const ConstVectorRef& hz, const std::vector<std::string>& names) const {
+  const GeneratedModel model = configured(*tape_, p);
+  refuse_descriptor(model, "frf_sensitivity");
+  const Eigen::Index in = model.input_index(input), out = model.output_index(output);
+  const mbsgen::OperatingPoint op = model.operating_point();
+  const LinearModel lin = model.linear_model(op);
+  const std::vector<MatrixSensitivity> d = model.linear_sensitivities(op, names);
+  const FrequencyResponseSensitivity s =
+      frequency_response_sensitivity(lin, d, std::vector<double>(hz.data(), hz.data() + hz.size()));
+  ResponseSensitivity r;
+  const Eigen::Index f = hz.size(), q = static_cast<Eigen::Index>(d.size());
+  r.values.resize(f);
+  r.rcond = Eigen::Map<const Vector>(s.rcond.data(), static_cast<Eigen::Index>(s.rcond.size()));
+  r.derivatives.resize(q, f);
+  for (Eigen::Index i = 0; i < f; ++i) {
+    r.values[i] = s.response[static_cast<std::size_t>(i)](out, in);
+    for (Eigen::Index j = 0; j < q; ++j)
+      r.derivatives(j, i) = s.derivative[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)](out, in);
+  }
+  r.parameter_values.resize(q);
+  for (Eigen::Index j = 0; j < q; ++j) {
+    r.parameters.push_back(d[static_cast<std::size_t>(j)].parameter);
+    r.parameter_values[j] = d[static_cast<std::size_t>(j)].value;
+  }
+  return r;
 }
 
 BatchResponse Model::frf_batch(const ConstRowMajorRef& sets, const std::string& input, const std::string& output,

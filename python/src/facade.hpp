@@ -62,6 +62,27 @@ struct Response {
   std::string method;
 };
 
+/// Eigenvalue sensitivities (runtime/spectral/sensitivity.hpp): every eigenvalue, both members of
+/// a conjugate pair, by each parameter asked for. Entries of a mode whose derivative is not defined
+/// (a repeated, defective, zero or infinite eigenvalue) are NaN, its note says why.
+struct ModeSensitivities {
+  Modes modes;
+  std::vector<std::string> parameters;
+  Vector parameter_values;
+  Eigen::MatrixXcd dlambda;  // modes × parameters, 1/s per unit of the parameter
+  Matrix dfrequency_hz, relative_frequency, ddamping_ratio;  // modes × parameters
+  std::vector<std::string> notes;  // per mode: "" or "repeated", "defective", "zero", "infinite"
+};
+
+/// A response and its derivatives by parameters (the direct method).
+struct ResponseSensitivity {
+  Eigen::VectorXcd values;
+  Eigen::MatrixXcd derivatives;  // parameters × frequencies: dz/dp
+  Vector rcond;
+  std::vector<std::string> parameters;
+  Vector parameter_values;
+};
+
 /// One response per parameter set: row k of values for set k, NaN where the set failed.
 struct BatchResponse {
   Eigen::MatrixXcd values;
@@ -112,6 +133,11 @@ class Model {
   /// input and output by name (NameError listing the known ones); method as `frf --method`.
   Response frf(const ConstVectorRef& p, const std::string& input, const std::string& output,
                const ConstVectorRef& hz, const std::string& method) const;
+  /// The derivatives of the modes by the named parameters (all when empty): forward mode over
+  /// the tape, or the compiled sensitivity kernel. Error for a model with rolling constraints.
+  ModeSensitivities modes_sensitivity(const ConstVectorRef& p, const std::vector<std::string>& names) const;
+  ResponseSensitivity frf_sensitivity(const ConstVectorRef& p, const std::string& input, const std::string& output,
+                                      const ConstVectorRef& hz, const std::vector<std::string>& names) const;
   /// frf for each row of sets (every parameter, in order), on `threads` threads (0: one per
   /// core). A set that fails (a negative mass, no equilibrium) leaves a row of NaN and its reason;
   /// the others are what frf gives for them, bit for bit. stop (may be empty) is asked after each

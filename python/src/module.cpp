@@ -82,6 +82,23 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def_readonly("warnings", &Response::warnings)
       .def_readonly("method", &Response::method);
 
+  py::class_<ModeSensitivities>(m, "ModeSensitivities")
+      .def_readonly("modes", &ModeSensitivities::modes)
+      .def_readonly("parameters", &ModeSensitivities::parameters)
+      .def_readonly("parameter_values", &ModeSensitivities::parameter_values)
+      .def_readonly("dlambda", &ModeSensitivities::dlambda)
+      .def_readonly("dfrequency_hz", &ModeSensitivities::dfrequency_hz)
+      .def_readonly("relative_frequency", &ModeSensitivities::relative_frequency)
+      .def_readonly("ddamping_ratio", &ModeSensitivities::ddamping_ratio)
+      .def_readonly("notes", &ModeSensitivities::notes);
+
+  py::class_<ResponseSensitivity>(m, "ResponseSensitivity")
+      .def_readonly("values", &ResponseSensitivity::values)
+      .def_readonly("derivatives", &ResponseSensitivity::derivatives)
+      .def_readonly("rcond", &ResponseSensitivity::rcond)
+      .def_readonly("parameters", &ResponseSensitivity::parameters)
+      .def_readonly("parameter_values", &ResponseSensitivity::parameter_values);
+
   py::class_<BatchResponse>(m, "BatchResponse")
       .def_readonly("values", &BatchResponse::values)
       .def_readonly("failed", &BatchResponse::failed)
@@ -129,6 +146,9 @@ PYBIND11_MODULE(_mbsgen, m) {
           },
           py::arg("sets"), py::arg("input"), py::arg("output"), py::arg("hz"), py::arg("method") = "auto",
           py::arg("threads") = 0, released)
+      .def("modes_sensitivity", &Model::modes_sensitivity, py::arg("p"), py::arg("names"), released)
+      .def("frf_sensitivity", &Model::frf_sensitivity, py::arg("p"), py::arg("input"), py::arg("output"),
+           py::arg("hz"), py::arg("names"), released)
       .def("outputs", &Model::outputs, py::arg("p"), released);
 
   // For bench/python_bench.py: the same facade calls timed in C++ (n calls in a row, seconds in
