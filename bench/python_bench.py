@@ -44,7 +44,7 @@ def per_call(model, calls, repeats):
         for _ in range(calls):
             model.linear()
         py_s.append((time.perf_counter() - t0) / calls)
-        cpp_s.append(_mbsgen._timing.linear(model._tape, p, calls) / calls)
+        cpp_s.append(_mbsgen._timing.linear(model._kernels, p, calls) / calls)
     return statistics.median(py_s), statistics.median(cpp_s)
 
 
@@ -72,7 +72,7 @@ def main():
         t0 = time.perf_counter()
         ear.frf("P", "v_stapes", hz)
         py_s.append(time.perf_counter() - t0)
-        cpp_s.append(_mbsgen._timing.frf(ear._tape, p, "P", "v_stapes", hz, 1))
+        cpp_s.append(_mbsgen._timing.frf(ear._kernels, p, "P", "v_stapes", hz, 1))
     py, cpp = statistics.median(py_s), statistics.median(cpp_s)
     print(f"frf 1000 points middle_ear: python {py * 1e3:.2f} ms, C++ {cpp * 1e3:.2f} ms, ratio {py / cpp:.3f}")
 

@@ -259,7 +259,10 @@ std::vector<Entry> entries(const fs::path& root, std::vector<Entry>* others = nu
       if (others && name.size() > 16 && is_key(name.substr(0, 16))) others->push_back(e);
       continue;
     }
-    e.kind = fs::exists(e.dir / "solve.sum", ec) ? "solver" : fs::exists(e.dir / "tape.sum", ec) ? "tape" : "damaged";
+    e.kind = fs::exists(e.dir / "solve.sum", ec)     ? "solver"
+             : fs::exists(e.dir / "tape.sum", ec)    ? "tape"
+             : fs::exists(e.dir / "kernels.sum", ec) ? "kernels"
+                                                     : "damaged";
     try {
       if (fs::exists(e.dir / "id", ec)) e.id = read_file(e.dir / "id");
       if (fs::exists(e.dir / "entry", ec)) {
@@ -377,17 +380,18 @@ int cache_info() {
   const fs::path root = cache_root();
   std::vector<Entry> building;
   const std::vector<Entry> all = entries(root, &building);
-  std::size_t solvers = 0, tapes = 0;
+  std::size_t solvers = 0, tapes = 0, kernels = 0;
   std::uintmax_t total = 0;
   for (const Entry& e : all) {
     solvers += e.kind == "solver";
     tapes += e.kind == "tape";
+    kernels += e.kind == "kernels";
     total += e.bytes;
   }
   for (const Entry& e : building) total += e.bytes;
   std::cout << "cache: " << root.string() << (fs::exists(root) ? "" : " (not created yet)") << "\n";
-  std::cout << "entries: " << all.size() << " (" << solvers << " solvers, " << tapes << " tapes, "
-            << all.size() - solvers - tapes << " damaged), " << building.size() << " builds or removals under way\n";
+  std::cout << "entries: " << all.size() << " (" << solvers << " solvers, " << tapes << " tapes, " << kernels
+            << " compiled kernels, " << all.size() - solvers - tapes - kernels << " damaged), " << building.size() << " builds or removals under way\n";
   std::cout << "size: " << human_size(total) << " (" << total << " bytes)\n";
   const std::optional<std::uintmax_t> limit = cache_limit();
   const char* set = std::getenv("MBSGEN_CACHE_MAX_SIZE");

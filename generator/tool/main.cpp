@@ -207,6 +207,9 @@ int main(int argc, char** argv) try {
   auto* tape_cmd = app.add_subcommand("tape", "make sure a model's tape is cached (as mbsgen run makes it) and print its path");
   tape_cmd->add_option("MODEL", model_file, "model file (YAML)")->required();
   tape_cmd->add_option("--scene", scene, "scene (default: the full model)");
+  auto* kernels_cmd = app.add_subcommand("kernels", "make sure a model's kernels are cached, compiled as a shared library, and print its path");
+  kernels_cmd->add_option("MODEL", model_file, "model file (YAML)")->required();
+  kernels_cmd->add_option("--scene", scene, "scene (default: the full model)");
   app.add_subcommand("linear", "modes and frequency responses of raw matrices (mbsgen linear --help)");
   app.add_subcommand("run", "generate, compile, cache and run a model's solver (mbsgen run --help)");
   auto* cache = app.add_subcommand("cache", "list, describe or clean the cache of mbsgen run");
@@ -227,14 +230,14 @@ int main(int argc, char** argv) try {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
-  if (*tape_cmd) {
+  if (*tape_cmd || *kernels_cmd) {
     try {
-      return mbsgen::tool::tape_main(model_file, scene);
+      return *tape_cmd ? mbsgen::tool::tape_main(model_file, scene) : mbsgen::tool::kernels_main(model_file, scene);
     } catch (const mbsgen::ModelError& e) {
       std::cerr << e.what() << "\n";
       return 1;
     } catch (const std::exception& e) {
-      std::cerr << "mbsgen tape: error: " << e.what() << "\n";
+      std::cerr << "mbsgen " << (*tape_cmd ? "tape" : "kernels") << ": error: " << e.what() << "\n";
       return 1;
     }
   }

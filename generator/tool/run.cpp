@@ -198,7 +198,7 @@ const char* parts_level(const GeneratedCode& code) {
 // part files hold only long straight-line arithmetic: -O1 compiles them faster than -O2, and
 // for large models runs as fast (parts_level); the rest takes -O2.
 std::vector<Job> compile_jobs(const Toolchain& tc, const fs::path& work, const GeneratedCode& code,
-                              std::vector<fs::path>& objects) {
+                              std::vector<fs::path>& objects, bool shared = false) {
   std::vector<std::pair<std::string, const char*>> units;
   const char* const parts = parts_level(code);
   for (std::size_t k = 0; k < code.parts.size(); ++k)
@@ -208,12 +208,34 @@ std::vector<Job> compile_jobs(const Toolchain& tc, const fs::path& work, const G
   std::vector<Job> jobs;
   for (const auto& [unit, level] : units) {
     std::vector<std::string> args = {tc.compiler, level, "-std=c++17", "-c"};
+    if (shared) args.insert(args.end(), {"-fPIC", "-ffunction-sections", "-fdata-sections"});
     args.insert(args.end(), tc.includes.begin(), tc.includes.end());
     objects.push_back(work / (unit + ".o"));
     args.insert(args.end(), {"-I" + work.string(), (work / (unit + ".cpp")).string(), "-o", objects.back().string()});
     jobs.push_back({args, work / ("compile-" + unit + ".log")});
   }
   return jobs;
+}
+
+// Runs the link command; removes the objects when it succeeded.
+bool link_objects(const std::vector<std::string>& link, const fs::path& work, const std::vector<fs::path>& objects,
+                  Progress& progress, const char* what) {
+  const fs::path log = work / "link.log";
+  int status = 0;
+  stop_if_terminated({});
+  const pid_t pid = spawn_program(link, log);
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return false;
+    stop_if_terminated({pid});
+  }
+  if (exit_status(status) == 0) {
+    std::error_code ec;
+    for (const auto& o : objects) fs::remove(o, ec);
+    return true;
+  }
+  progress.stop();
+  std::cerr << "mbsgen run: error: linking " << what << " failed; see " << log.string() << "\n";
+  return false;
 }
 
 // Compiles and links the solver in work; false (with a message naming the log) when the
@@ -233,27 +255,37 @@ bool compile_solver(const Toolchain& tc, const fs::path& work, const GeneratedCo
     link.insert(link.end(), {"-o", (work / "solve").string()});
     link.insert(link.end(), tc.libraries.begin(), tc.libraries.end());
     if (!debug) link.push_back("-Wl,--strip-debug");
-    const fs::path log = work / "link.log";
-    int status = 0;
-    stop_if_terminated({});
-    const pid_t pid = spawn_program(link, log);
-    while (::waitpid(pid, &status, 0) < 0) {
-      if (errno != EINTR) return false;
-      stop_if_terminated({pid});
-    }
-    if (exit_status(status) == 0) {
-      std::error_code ec;
-      for (const auto& o : objects) fs::remove(o, ec);
-      return true;
-    }
-    progress.stop();
-    std::cerr << "mbsgen run: error: linking the solver failed; see " << log.string() << "\n";
-    return false;
+    return link_objects(link, work, objects, progress, "the solver");
   }
   progress.stop();
   std::cerr << "mbsgen run: error: compiling the solver failed; see " << jobs[failed.front()].log.string() << "\n";
   return false;
 }
+
+// Compiles the kernels, their parts and the typed API's kernels() into the shared library
+// work/kernels (issue 41: what the Python package loads for a model without a tape, or when asked
+// for compiled kernels). main.cpp exports one function, mbsgen_model_kernels(); the link keeps only
+// it (a version script) and what it reaches (--gc-sections), so the typed API's functions that
+// call the runtime are dropped and the library needs nothing but libc, libm and libstdc++.
+bool compile_kernels(const Toolchain& tc, const fs::path& work, const GeneratedCode& code, std::size_t parallel,
+                     Progress& progress) {
+  std::vector<fs::path> objects;
+  const std::vector<Job> jobs = compile_jobs(tc, work, code, objects, true);
+  progress.stage("compiling the kernels");
+  const std::vector<std::size_t> failed = run_jobs(jobs, parallel, progress);
+  if (failed.empty()) {
+    progress.stage("linking the kernels");
+    std::vector<std::string> link = {tc.compiler, "-shared"};
+    for (const auto& o : objects) link.push_back(o.string());
+    link.insert(link.end(), {"-o", (work / "kernels").string(), "-Wl,--version-script=" + (work / "exports.map").string(),
+                             "-Wl,--gc-sections", "-Wl,--strip-debug", "-Wl,-z,defs", "-lm"});
+    return link_objects(link, work, objects, progress, "the kernels");
+  }
+  progress.stop();
+  std::cerr << "mbsgen run: error: compiling the kernels failed; see " << jobs[failed.front()].log.string() << "\n";
+  return false;
+}
+
 
 // The model of a cache entry derived, linearized, checked and emitted (with id "model").
 struct Emitted {
@@ -386,6 +418,27 @@ bool build_solver(const std::string& model_file, const std::string& scene, bool 
   });
 }
 
+// Compiles model_file's kernels into the shared library "kernels" of the cache entry dir
+// (compile_kernels), for programs that load them (the Python package).
+bool build_kernels(const std::string& model_file, const std::string& scene, const std::string& text, const Toolchain& tc,
+                   const fs::path& dir, std::optional<EntryLock>& lock, Progress& progress) {
+  const std::size_t parallel = parallel_jobs();
+  const Emitted e = emit_model(model_file, scene, false, std::nullopt, 2 * parallel, progress);
+  return make_entry(dir, lock, [&](const fs::path& work) {
+    write_generated(e.code, e.api, work.string());
+    write_files({{work / "main.cpp",
+                  "#include \"model_model.hpp\"\n"
+                  "extern \"C\" const mbsgen::ModelKernels* mbsgen_model_kernels() { return &model::kernels(); }\n"},
+                 {work / "exports.map", "{ global: mbsgen_model_kernels; local: *; };\n"},
+                 {work / "model.yaml", text},
+                 {work / "id", e.id}});
+    describe_entry(work, model_file, scene, "kernels", "");
+    if (!compile_kernels(tc, work, e.code, parallel, progress)) return false;
+    write_files({{work / "kernels.sum", artifact_record(work / "kernels")}});  // last: the entry is complete
+    return true;
+  });
+}
+
 // Generates the tape of model_file into the cache entry dir (make_entry): the file "tape", empty
 // for a model with closed loops (which only a compiled solver evaluates).
 void build_tape(const std::string& model_file, const std::string& scene, const std::string& text, const fs::path& dir,
@@ -509,6 +562,33 @@ int tape_main(const std::string& model_file, const std::string& scene) {
     return 3;
   }
   std::cout << (dir / "tape").string() << "\n";
+  return 0;
+#endif
+}
+
+int kernels_main(const std::string& model_file, const std::string& scene) {
+#ifndef MBSGEN_RUN_AVAILABLE
+  (void)model_file, (void)scene;
+  std::cerr << "mbsgen kernels: this mbsgen was built without the runtime (MBSGEN_BUILD_RUNTIME=OFF)\n";
+  return 1;
+#else
+  const std::string text = read_model_text(model_file);  // throws: reported by the caller, exit 1
+  cache_limit();
+  const Toolchain tc = toolchain();
+  const fs::path dir = entry_dir(solver_key(text, scene, false, false, std::nullopt, tc) + '\0' + "shared kernels");
+  std::optional<EntryLock> lock;
+  if (const int status = ensure_entry(dir, "kernels", model_file, lock, [&] {
+        try {
+          TerminationGuard guard;
+          Progress progress("kernels");
+          return build_kernels(model_file, scene, text, tc, dir, lock, progress) ? 0 : 1;
+        } catch (const Terminated& t) {
+          std::cerr << "mbsgen kernels: " << t.what() << "; the kernels were not built\n";
+          return 128 + t.signal;
+        }
+      }))
+    return status;
+  std::cout << (dir / "kernels").string() << "\n";
   return 0;
 #endif
 }

@@ -20,6 +20,11 @@ int run_main(const std::string& model_file, const std::string& scene, std::vecto
 /// with closed loops (no tape). For programs that load the tape themselves (the Python package,
 /// mbsgen::TapeModel). Throws as run_main.
 int tape_main(const std::string& model_file, const std::string& scene);
+/// `mbsgen kernels MODEL [--scene NAME]`: makes sure the model's kernels are in the cache compiled
+/// as a shared library (exporting `const mbsgen::ModelKernels* mbsgen_model_kernels()`; any model,
+/// closed loops included) and prints its path. For programs that load compiled kernels (the Python
+/// package). Throws as run_main.
+int kernels_main(const std::string& model_file, const std::string& scene);
 /// A T made by make() and never destroyed. The derivation of a large model is millions of GiNaC
 /// nodes, and freeing them one by one took 5 % of a 40-link chain's generation; the process's
 /// exit reclaims them at once. A global list keeps them reachable (no leak for LeakSanitizer).

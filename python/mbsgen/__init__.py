@@ -58,16 +58,41 @@ def tool() -> str:
     raise Error("mbsgen: the mbsgen command was not found (set MBSGEN to its path, or put it on PATH)")
 
 
-def _cached_tape(path: str, scene: Optional[str]) -> str:
+def _cached(command: str, path: str, scene: Optional[str]):
+    """`mbsgen tape|kernels PATH [--scene SCENE]`: (exit code, the artifact's path, the messages)."""
     # The generator as a separate program, its arguments a list: nothing goes through a shell.
-    args = [tool(), "tape", path]
+    args = [tool(), command, path]
     if scene is not None:
         args += ["--scene", scene]
     done = subprocess.run(args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                           text=True, check=False)
-    if done.returncode != 0:
-        raise ModelError(done.stderr.strip() or f"mbsgen tape {path} failed (exit {done.returncode})")
-    return done.stdout.strip()
+    return done.returncode, done.stdout.strip(), done.stderr.strip()
+
+
+_CLOSED_LOOPS = 3  # `mbsgen tape`'s exit code for a model without a tape
+
+
+def _artifact(path: str, scene: Optional[str], compiled: Optional[bool]) -> str:
+    if compiled is not True:
+        code, out, err = _cached("tape", path, scene)
+        if code == 0:
+            return out
+        if code != _CLOSED_LOOPS or compiled is False:
+            raise ModelError(err or f"mbsgen tape {path} failed (exit {code})")
+    code, out, err = _cached("kernels", path, scene)
+    if code != 0:
+        raise ModelError(err or f"mbsgen kernels {path} failed (exit {code})")
+    return out
+
+
+def _is_loaded_directly(path: str) -> bool:
+    if path.endswith(".tape"):
+        return True
+    try:
+        with open(path, "rb") as f:
+            return f.read(4) == b"\x7fELF"
+    except OSError:
+        return False
 
 
 class Modes(NamedTuple):
@@ -125,30 +150,35 @@ def _frequencies(frequencies) -> np.ndarray:
 
 
 class Model:
-    """A multibody model: Model(path, scene=None) for a model file (YAML, generated and cached as
-    `mbsgen run` does) or a tape (`.tape`, from `mbsgen generate --tape`).
+    """A multibody model: Model(path, scene=None, compiled=None) for a model file (YAML, generated
+    and cached as `mbsgen run` does), a tape (`.tape`, from `mbsgen generate --tape`) or a library
+    of compiled kernels (`mbsgen kernels`).
+
+    A model file is evaluated from its tape (no compiler), or, for a model with closed loops (no
+    tape) or with compiled=True, from its kernels compiled into a shared library (cached; seconds
+    the first time, faster per call). compiled=False refuses the compiler.
 
     parameters, coordinates, inputs and outputs name what the analyses take and return; each
     analysis takes parameter values by keyword (SI units), the others keeping their defaults."""
 
-    def __init__(self, path, scene: Optional[str] = None):
+    def __init__(self, path, scene: Optional[str] = None, compiled: Optional[bool] = None):
         path = os.fspath(path)
-        tape = path if path.endswith(".tape") and scene is None else _cached_tape(path, scene)
-        self._tape = _mbsgen.TapeModel(tape)
-        names = self._tape.parameter_names
+        direct = scene is None and compiled is None and _is_loaded_directly(path)
+        self._kernels = _mbsgen.Model(path if direct else _artifact(path, scene, compiled))
+        names = self._kernels.parameter_names
         self._index: Dict[str, int] = {n: i for i, n in enumerate(names)}
         self.parameters: List[Parameter] = [
-            Parameter(n, float(d), u) for n, d, u in zip(names, self._tape.parameter_defaults, self._tape.parameter_units)]
+            Parameter(n, float(d), u) for n, d, u in zip(names, self._kernels.parameter_defaults, self._kernels.parameter_units)]
         self._defaults = np.array([q.default for q in self.parameters], dtype=np.float64)
-        self.coordinates: List[str] = list(self._tape.coordinate_names)
-        self.coordinate_units: List[str] = list(self._tape.coordinate_units)
-        self.inputs: List[str] = list(self._tape.input_names)
-        self.input_units: List[str] = list(self._tape.input_units)
-        self.outputs: List[str] = list(self._tape.output_names)
-        self.output_units: List[str] = list(self._tape.output_units)
-        self.name: str = self._tape.name
-        self.scene: str = self._tape.scene
-        self.evaluation: str = self._tape.evaluation
+        self.coordinates: List[str] = list(self._kernels.coordinate_names)
+        self.coordinate_units: List[str] = list(self._kernels.coordinate_units)
+        self.inputs: List[str] = list(self._kernels.input_names)
+        self.input_units: List[str] = list(self._kernels.input_units)
+        self.outputs: List[str] = list(self._kernels.output_names)
+        self.output_units: List[str] = list(self._kernels.output_units)
+        self.name: str = self._kernels.name
+        self.scene: str = self._kernels.scene
+        self.evaluation: str = self._kernels.evaluation
 
     def __repr__(self) -> str:
         return (f"<mbsgen.Model {self.name!r} scene {self.scene!r}: {len(self.coordinates)} coordinates, "
@@ -170,7 +200,7 @@ class Model:
 
     def operating_point(self, **params: float):
         """y0, yd0 and how they were found (given by the model, or a static equilibrium)."""
-        return self._tape.operating_point(self.parameter_values(**params))
+        return self._kernels.operating_point(self.parameter_values(**params))
 
     def static(self, **params: float):
         """The static equilibrium (or the model's given operating point): as operating_point."""
@@ -179,11 +209,11 @@ class Model:
     def linear(self, **params: float):
         """The linear model at the operating point: M, Q, K, B, C_y, C_v (and C_a, D, B1, B2, D1,
         0×0 when zero) as NumPy arrays; for a model with rolling constraints E, A, B, C, D."""
-        return self._tape.linear(self.parameter_values(**params))
+        return self._kernels.linear(self.parameter_values(**params))
 
     def modes(self, all: bool = False, **params: float) -> Modes:
         """The eigenvalues of the linear model (see Modes)."""
-        return _modes(self._tape.modes(self.parameter_values(**params), all))
+        return _modes(self._kernels.modes(self.parameter_values(**params), all))
 
     def frf(self, input: str, output: str, frequencies: Sequence[float], method: str = "auto", params=None,
             threads: int = 0, **values: float):
@@ -196,9 +226,9 @@ class Model:
         as given by keyword). Returns a BatchResponse."""
         hz = _frequencies(frequencies)
         if params is None:
-            r = self._tape.frf(self.parameter_values(**values), input, output, hz, method)
+            r = self._kernels.frf(self.parameter_values(**values), input, output, hz, method)
             return Response(hz, r.values, r.rcond, list(r.flags), list(r.warnings), r.method)
-        b = self._tape.frf_batch(self.parameter_sets(params, **values), input, output, hz, method, int(threads))
+        b = self._kernels.frf_batch(self.parameter_sets(params, **values), input, output, hz, method, int(threads))
         return BatchResponse(hz, b.values, list(zip(b.failed, b.reasons)))
 
     def modes_sensitivity(self, parameters: Optional[Sequence[str]] = None, **values: float):
@@ -207,14 +237,14 @@ class Model:
         parameters, parameter_values, dlambda (modes × parameters, 1/s per unit), dfrequency_hz,
         relative_frequency ((p/f) df/dp), ddamping_ratio, and notes (why a mode's derivative is
         not defined: repeated, defective, zero, infinite; its entries are NaN)."""
-        return self._tape.modes_sensitivity(self.parameter_values(**values), list(parameters or []))
+        return self._kernels.modes_sensitivity(self.parameter_values(**values), list(parameters or []))
 
     def frf_sensitivity(self, input: str, output: str, frequencies: Sequence[float],
                         parameters: Optional[Sequence[str]] = None, **values: float):
         """The response and dz/dp by the named parameters (all when None) at `frequencies` (Hz):
         values, derivatives (parameters × frequencies), rcond, parameters, parameter_values."""
         hz = _frequencies(frequencies)
-        return self._tape.frf_sensitivity(self.parameter_values(**values), input, output, hz, list(parameters or []))
+        return self._kernels.frf_sensitivity(self.parameter_values(**values), input, output, hz, list(parameters or []))
 
     def parameter_sets(self, params, **values: float) -> np.ndarray:
         """params (an array of shape (n_sets, len(parameters)), or a dict {name: n_sets values}) as
@@ -242,7 +272,7 @@ class Model:
 
     def output_values(self, **params: float) -> np.ndarray:
         """The outputs at the operating point."""
-        return self._tape.outputs(self.parameter_values(**params))
+        return self._kernels.outputs(self.parameter_values(**params))
 
 
 class linear:  # noqa: N801 (a namespace: mbsgen.linear.modes, mbsgen.linear.frf)

@@ -10,7 +10,10 @@
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 #include "mbsgen/runtime/spectral/sensitivity.hpp"
 
+#include <dlfcn.h>
+
 #include <algorithm>
+#include <fstream>
 #include <atomic>
 #include <cmath>
 #include <exception>
@@ -29,9 +32,9 @@ constexpr double kTwoPi = 6.283185307179586;
 
 std::vector<std::string> names(const char* const* list, int n) { return n > 0 && list ? name_list(list, n) : std::vector<std::string>(); }
 
-// A GeneratedModel over the tape's kernels with the parameters p (every one, in order).
-GeneratedModel configured(const TapeModel& tape, const ConstVectorRef& p) {
-  GeneratedModel model(tape.kernels());
+// A GeneratedModel over the kernels with the parameters p (every one, in order).
+GeneratedModel configured(const ModelKernels& kernels, const ConstVectorRef& p) {
+  GeneratedModel model(kernels);
   model.set_parameters(std::vector<double>(p.data(), p.data() + p.size()));
   return model;
 }
@@ -88,63 +91,79 @@ Response second_order_response(const LinearModel& lin, Eigen::Index input, Eigen
 
 }  // namespace
 
-Model::Model(const std::string& tape_path) : tape_(TapeModel::load(tape_path)) {}
+Model::Model(const std::string& path) {
+  char magic[4] = {};
+  std::ifstream(path, std::ios::binary).read(magic, 4);
+  if (std::string(magic, 4) != "\x7f" "ELF") {
+    tape_ = TapeModel::load(path);
+    kernels_ = &tape_->kernels();
+    return;
+  }
+  void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!handle) throw Error(std::string("cannot load the compiled kernels ") + path + ": " + ::dlerror());
+  library_ = std::shared_ptr<void>(handle, [](void* h) { ::dlclose(h); });
+  using Entry = const ModelKernels* (*)();
+  const auto entry = reinterpret_cast<Entry>(::dlsym(handle, "mbsgen_model_kernels"));
+  if (!entry) throw Error(path + " is not a library of compiled kernels (no mbsgen_model_kernels; made by `mbsgen kernels`)");
+  kernels_ = entry();
+  GeneratedModel check(*kernels_);  // throws for kernels of another ABI version
+}
 Model::~Model() = default;
 
-std::string Model::name() const { return tape_->kernels().model; }
-std::string Model::scene() const { return tape_->kernels().scene; }
+std::string Model::name() const { return (*kernels_).model; }
+std::string Model::scene() const { return (*kernels_).scene; }
 std::string Model::evaluation() const {
-  const char* e = tape_->kernels().evaluation;
+  const char* e = (*kernels_).evaluation;
   return e ? e : "compiled";
 }
 std::vector<std::string> Model::parameter_names() const {
-  const ModelKernels& k = tape_->kernels();
+  const ModelKernels& k = (*kernels_);
   return names(k.parameter_names, k.n_parameters);
 }
 std::vector<std::string> Model::parameter_units() const {
-  const ModelKernels& k = tape_->kernels();
+  const ModelKernels& k = (*kernels_);
   return names(k.parameter_units, k.n_parameters);
 }
 Vector Model::parameter_defaults() const {
-  const ModelKernels& k = tape_->kernels();
+  const ModelKernels& k = (*kernels_);
   return Eigen::Map<const Vector>(k.parameter_defaults, k.n_parameters);
 }
 std::vector<std::string> Model::coordinate_names() const {
-  const ModelKernels& k = tape_->kernels();
+  const ModelKernels& k = (*kernels_);
   return names(k.coordinate_names, k.n_coordinates);
 }
 std::vector<std::string> Model::coordinate_units() const {
-  const ModelKernels& k = tape_->kernels();
+  const ModelKernels& k = (*kernels_);
   return names(k.coordinate_units, k.n_coordinates);
 }
 std::vector<std::string> Model::input_names() const {
-  const ModelKernels& k = tape_->kernels();
+  const ModelKernels& k = (*kernels_);
   return names(k.input_names, k.n_inputs);
 }
 std::vector<std::string> Model::input_units() const {
-  const ModelKernels& k = tape_->kernels();
+  const ModelKernels& k = (*kernels_);
   return names(k.input_units, k.n_inputs);
 }
 std::vector<std::string> Model::output_names() const {
-  const ModelKernels& k = tape_->kernels();
+  const ModelKernels& k = (*kernels_);
   return names(k.output_names, k.n_outputs);
 }
 std::vector<std::string> Model::output_units() const {
-  const ModelKernels& k = tape_->kernels();
+  const ModelKernels& k = (*kernels_);
   return names(k.output_units, k.n_outputs);
 }
-bool Model::descriptor() const { return tape_->kernels().descriptor != nullptr; }
-double Model::default_from_hz() const { return tape_->kernels().default_from_hz; }
-double Model::default_to_hz() const { return tape_->kernels().default_to_hz; }
-int Model::default_points() const { return tape_->kernels().default_points; }
+bool Model::descriptor() const { return (*kernels_).descriptor != nullptr; }
+double Model::default_from_hz() const { return (*kernels_).default_from_hz; }
+double Model::default_to_hz() const { return (*kernels_).default_to_hz; }
+int Model::default_points() const { return (*kernels_).default_points; }
 
 OperatingPoint Model::operating_point(const ConstVectorRef& p) const {
-  const mbsgen::OperatingPoint op = configured(*tape_, p).operating_point();
+  const mbsgen::OperatingPoint op = configured(*kernels_, p).operating_point();
   return {op.y0, op.yd0, op.equilibrium, op.iterations, op.residual_norm, op.report};
 }
 
 Linear Model::linear(const ConstVectorRef& p) const {
-  const GeneratedModel model = configured(*tape_, p);
+  const GeneratedModel model = configured(*kernels_, p);
   Linear r;
   if (model.is_descriptor()) {
     const DescriptorModel d = model.descriptor_model();
@@ -160,7 +179,7 @@ Linear Model::linear(const ConstVectorRef& p) const {
 }
 
 Modes Model::modes(const ConstVectorRef& p, bool all) const {
-  const GeneratedModel model = configured(*tape_, p);
+  const GeneratedModel model = configured(*kernels_, p);
   if (model.is_descriptor()) {
     const DescriptorModel d = model.descriptor_model();
     DescriptorEigenOptions opt;
@@ -174,7 +193,7 @@ Modes Model::modes(const ConstVectorRef& p, bool all) const {
 
 Response Model::frf(const ConstVectorRef& p, const std::string& input, const std::string& output,
                     const ConstVectorRef& hz, const std::string& method) const {
-  const GeneratedModel model = configured(*tape_, p);
+  const GeneratedModel model = configured(*kernels_, p);
   const Eigen::Index in = model.input_index(input), out = model.output_index(output);
   if (model.is_descriptor()) {
     const DescriptorFrf d = descriptor_frequency_response(model.descriptor_model(), Eigen::VectorXd(hz) * kTwoPi, in, {out});
@@ -200,7 +219,7 @@ void refuse_descriptor(const GeneratedModel& model, const char* what) {
 }  // namespace
 
 ModeSensitivities Model::modes_sensitivity(const ConstVectorRef& p, const std::vector<std::string>& names) const {
-  const GeneratedModel model = configured(*tape_, p);
+  const GeneratedModel model = configured(*kernels_, p);
   refuse_descriptor(model, "modes_sensitivity");
   const mbsgen::OperatingPoint op = model.operating_point();
   const LinearModel lin = model.linear_model(op);
@@ -240,7 +259,7 @@ ModeSensitivities Model::modes_sensitivity(const ConstVectorRef& p, const std::v
 
 ResponseSensitivity Model::frf_sensitivity(const ConstVectorRef& p, const std::string& input, const std::string& output,
                                            const ConstVectorRef& hz, const std::vector<std::string>& names) const {
-  const GeneratedModel model = configured(*tape_, p);
+  const GeneratedModel model = configured(*kernels_, p);
   refuse_descriptor(model, "frf_sensitivity");
   const Eigen::Index in = model.input_index(input), out = model.output_index(output);
   const mbsgen::OperatingPoint op = model.operating_point();
@@ -270,11 +289,11 @@ BatchResponse Model::frf_batch(const ConstRowMajorRef& sets, const std::string& 
                                const ConstVectorRef& hz, const std::string& method, int threads,
                                const std::function<bool()>& stop) const {
   const Eigen::Index n = sets.rows();
-  if (sets.cols() != tape_->kernels().n_parameters)
+  if (sets.cols() != (*kernels_).n_parameters)
     throw DimensionError("frf_batch: the parameter sets have " + std::to_string(sets.cols()) + " columns, the model " +
-                         std::to_string(tape_->kernels().n_parameters) + " parameters");
+                         std::to_string((*kernels_).n_parameters) + " parameters");
   {  // names and the method checked once, before any thread starts
-    const GeneratedModel model(tape_->kernels());
+    const GeneratedModel model((*kernels_));
     (void)model.input_index(input);
     (void)model.output_index(output);
     parse_frf_method(method);
@@ -313,7 +332,7 @@ BatchResponse Model::frf_batch(const ConstRowMajorRef& sets, const std::string& 
 }
 
 Vector Model::outputs(const ConstVectorRef& p) const {
-  const GeneratedModel model = configured(*tape_, p);
+  const GeneratedModel model = configured(*kernels_, p);
   return model.outputs(model.operating_point());
 }
 

@@ -17,6 +17,7 @@
 
 namespace mbsgen {
 class TapeModel;
+struct ModelKernels;
 }
 
 namespace mbsgen::python {
@@ -99,17 +100,19 @@ class Stopped : public std::runtime_error {
   Stopped() : std::runtime_error("stopped") {}
 };
 
-/// A model from a tape file (`mbsgen tape MODEL` prints the cached one's path).
+/// A model from a tape file (`mbsgen tape MODEL` prints the cached one's path) or from a shared
+/// library of compiled kernels (`mbsgen kernels MODEL`: any model, closed loops included), told
+/// apart by their first bytes.
 class Model {
  public:
-  explicit Model(const std::string& tape_path);
+  explicit Model(const std::string& path);
   ~Model();
   Model(const Model&) = delete;
   Model& operator=(const Model&) = delete;
 
   std::string name() const;
   std::string scene() const;
-  std::string evaluation() const;  // "tape"
+  std::string evaluation() const;  // "tape" or "compiled"
   std::vector<std::string> parameter_names() const;
   std::vector<std::string> parameter_units() const;
   Vector parameter_defaults() const;
@@ -150,7 +153,9 @@ class Model {
   Vector outputs(const ConstVectorRef& p) const;
 
  private:
+  std::shared_ptr<void> library_;  // the compiled kernels' dlopen handle (declared first: closed last)
   std::unique_ptr<TapeModel> tape_;
+  const ModelKernels* kernels_ = nullptr;
 };
 
 /// Modes of M ÿ + Q ẏ + K y = 0 given as matrices (Q may be 0×0: zero).

@@ -105,7 +105,7 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def_readonly("reasons", &BatchResponse::reasons);
 
   const auto released = py::call_guard<py::gil_scoped_release>();
-  py::class_<Model>(m, "TapeModel")
+  py::class_<Model>(m, "Model")
       .def(py::init<const std::string&>(), py::arg("path"), released)
       .def_property_readonly("name", &Model::name)
       .def_property_readonly("scene", &Model::scene)

@@ -74,7 +74,7 @@ TEST(MbsgenCache, ListInfoAndCleanDescribeTheEntries) {
   r = run({MBSGEN_TOOL, "cache", "info"}, dir, env);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("cache: " + cache.string() + "\n"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("entries: 2 (1 solvers, 1 tapes, 0 damaged)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("entries: 2 (1 solvers, 1 tapes, 0 compiled kernels, 0 damaged)"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("(" + std::to_string(bytes_under(cache)) + " bytes)"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("limit: 4.0 GiB (the default"), std::string::npos) << r.output;
 
