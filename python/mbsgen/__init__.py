@@ -270,6 +270,24 @@ class Model:
             raise ValueError("params: give the values either in params or by keyword, not both")
         return sets
 
+    def mass_matrix(self, y, **params: float) -> np.ndarray:
+        """M(y) (a model without closed loops or rolling constraints)."""
+        return self._kernels.mass_matrix(self.parameter_values(**params), self._vector("y", y))
+
+    def accelerations(self, y, yd, u=None, **params: float) -> np.ndarray:
+        """ÿ = −M(y)⁻¹ (k − q)(y, ẏ, u): the right-hand side of the equations of motion, for an
+        integrator (a model without closed loops or rolling constraints; u None: zero inputs)."""
+        u = np.zeros(len(self.inputs)) if u is None else u
+        return self._kernels.accelerations(self.parameter_values(**params), self._vector("y", y),
+                                           self._vector("yd", yd), self._vector("u", u))
+
+    @staticmethod
+    def _vector(name: str, v) -> np.ndarray:
+        a = np.ascontiguousarray(v, dtype=np.float64)
+        if a.ndim != 1:
+            raise ValueError(f"{name}: a 1-D array, not one of shape {a.shape}")
+        return a
+
     def output_values(self, **params: float) -> np.ndarray:
         """The outputs at the operating point."""
         return self._kernels.outputs(self.parameter_values(**params))

@@ -336,6 +336,62 @@ Vector Model::outputs(const ConstVectorRef& p) const {
   return model.outputs(model.operating_point());
 }
 
+namespace {
+
+// The tree's own equations M ÿ + r = 0 are the model's only without loops or rolling constraints.
+void require_explicit(const ModelKernels& k, const char* what) {
+  if (k.n_constraints > 0 || k.descriptor)
+    throw Error(std::string(what) + ": model '" + k.model + "' has " +
+                (k.descriptor ? "rolling constraints" : "closed loops") +
+                ": its equations of motion are not M(y) ÿ + r(y, ẏ, u) = 0 in its coordinates");
+}
+
+void require_size(const ConstVectorRef& v, Eigen::Index n, const char* what, const char* name) {
+  if (v.size() != n)
+    throw DimensionError(std::string(what) + ": " + name + " has " + std::to_string(v.size()) + " entries, the model " +
+                         std::to_string(n));
+}
+
+void require_finite(const double* v, Eigen::Index n, const char* what, const char* kernel) {
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!std::isfinite(v[i])) throw NonFiniteError(std::string(what) + ": the kernel " + kernel + " gave a value that is not finite");
+}
+
+}  // namespace
+
+Matrix Model::mass_matrix(const ConstVectorRef& p, const ConstVectorRef& y) const {
+  const ModelKernels& k = *kernels_;
+  require_explicit(k, "mass_matrix");
+  require_size(p, k.n_parameters, "mass_matrix", "p");
+  require_size(y, k.n_coordinates, "mass_matrix", "y");
+  Matrix M(k.n_coordinates, k.n_coordinates);
+  k.mass_matrix(y.data(), p.data(), M.data());
+  require_finite(M.data(), M.size(), "mass_matrix", "mass_matrix");
+  return M;
+}
+
+Vector Model::accelerations(const ConstVectorRef& p, const ConstVectorRef& y, const ConstVectorRef& yd,
+                            const ConstVectorRef& u) const {
+  const ModelKernels& k = *kernels_;
+  require_explicit(k, "accelerations");
+  require_size(p, k.n_parameters, "accelerations", "p");
+  require_size(y, k.n_coordinates, "accelerations", "y");
+  require_size(yd, k.n_coordinates, "accelerations", "yd");
+  require_size(u, k.n_inputs, "accelerations", "u");
+  Matrix M(k.n_coordinates, k.n_coordinates);
+  Vector r(k.n_coordinates);
+  k.mass_matrix(y.data(), p.data(), M.data());
+  k.residual(y.data(), yd.data(), u.data(), p.data(), r.data());
+  require_finite(M.data(), M.size(), "accelerations", "mass_matrix");
+  require_finite(r.data(), r.size(), "accelerations", "residual");
+  const Eigen::PartialPivLU<Matrix> lu(M);
+  const double rcond = lu.rcond();
+  if (!(rcond > 1e-14))
+    throw SingularSystemError("accelerations: M(y) is singular to working precision (reciprocal condition " +
+                              std::to_string(rcond) + ")");
+  return lu.solve(-r);
+}
+
 Modes modes_of(const ConstMatrixRef& M, const ConstMatrixRef& Q, const ConstMatrixRef& K, bool all) {
   const Eigen::Index f = M.rows();
   const LinearModel lin(M, Q.size() == 0 ? Matrix::Zero(f, f) : Matrix(Q), K);

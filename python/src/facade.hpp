@@ -151,6 +151,14 @@ class Model {
                           const std::function<bool()>& stop = {}) const;
   /// The outputs at the operating point.
   Vector outputs(const ConstVectorRef& p) const;
+  /// M(y) and the accelerations ÿ = −M(y)⁻¹ r(y, ẏ, u) of the equations of motion M ÿ + r = 0
+  /// (r = k − q, the `residual` kernel): the right-hand side an integrator calls. A model with
+  /// closed loops or rolling constraints has no such explicit form here (Error); DimensionError
+  /// for vectors of the wrong size, NonFiniteError for a kernel value that is not finite,
+  /// SingularSystemError for a singular M.
+  Matrix mass_matrix(const ConstVectorRef& p, const ConstVectorRef& y) const;
+  Vector accelerations(const ConstVectorRef& p, const ConstVectorRef& y, const ConstVectorRef& yd,
+                       const ConstVectorRef& u) const;
 
  private:
   std::shared_ptr<void> library_;  // the compiled kernels' dlopen handle (declared first: closed last)

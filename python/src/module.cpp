@@ -149,7 +149,9 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def("modes_sensitivity", &Model::modes_sensitivity, py::arg("p"), py::arg("names"), released)
       .def("frf_sensitivity", &Model::frf_sensitivity, py::arg("p"), py::arg("input"), py::arg("output"),
            py::arg("hz"), py::arg("names"), released)
-      .def("outputs", &Model::outputs, py::arg("p"), released);
+      .def("outputs", &Model::outputs, py::arg("p"), released)
+      .def("mass_matrix", &Model::mass_matrix, py::arg("p"), py::arg("y"))
+      .def("accelerations", &Model::accelerations, py::arg("p"), py::arg("y"), py::arg("yd"), py::arg("u"));
 
   // For bench/python_bench.py: the same facade calls timed in C++ (n calls in a row, seconds in
   // all), so that the Python overhead per call is a difference measured in one process.

@@ -329,3 +329,26 @@ class TestSensitivities:
                 assert abs(fd - d) <= 1e-4 * abs(d) + 1e-12 * abs(lam) / h, (name, k, fd, d)
                 checked += 1
         assert checked > 0
+
+
+class TestRightHandSide:
+    def test_simple_pendulum_closed_form(self):
+        # m l² φ̈ = −m g l sin φ: φ̈ = −(g/l) sin φ, a few roundings.
+        m = model("models/textbook/simple_pendulum.yaml", "full")
+        for phi, l in ((0.3, 1.0), (2.5, 0.7), (-1.2, 2.0)):
+            a = m.accelerations([phi], [0.4], l=l)
+            assert a.shape == (1,)
+            assert abs(a[0] + 9.81 / l * np.sin(phi)) <= 4e-16 * 9.81 / l
+
+    def test_mass_matrix_at_rest_is_the_linear_models(self):
+        m = model("models/textbook/double_pendulum.yaml", "full")
+        assert np.array_equal(m.mass_matrix([0.0, 0.0], m1=1.7), m.linear(m1=1.7).M)
+
+    def test_bad_states(self):
+        m = model("models/textbook/double_pendulum.yaml", "full")
+        with pytest.raises(ValueError, match="accelerations: y has 3 entries, the model 2"):
+            m.accelerations([0.0, 0.0, 0.0], [0.0, 0.0])
+        with pytest.raises(ValueError, match="y: a 1-D array"):
+            m.accelerations([[0.0, 0.0]], [0.0, 0.0])
+        with pytest.raises(mbsgen.Error, match="closed loops"):
+            model("models/linkages/four_bar.yaml", "full").accelerations([0.0], [0.0])
