@@ -270,6 +270,39 @@ class Model:
             raise ValueError("params: give the values either in params or by keyword, not both")
         return sets
 
+    def simulate(self, duration: float, step: float = 0.0, initial: Optional[Dict[str, float]] = None,
+                 inputs: Optional[Dict[str, object]] = None, method: str = "bdf", rtol: float = 1e-8,
+                 atol: float = 1e-10, outputs: bool = True, **params: float):
+        """Integrates the nonlinear equations of motion from the operating point over [0, duration]
+        (s), sampled every `step` (default duration/1000). initial: coordinates and rates by name
+        ({"phi": 0.3, "phi_dot": 0}); inputs: per input name a number, a signal in the command
+        line's form ("sine:AMPLITUDE,HZ[,PHASE_DEG[,OFFSET]]", "step:AMPLITUDE[,TIME[,BEFORE]]",
+        "chirp:AMPLITUDE,F0,F1[,DURATION]") or a table (times, values); method: bdf, adams, radau,
+        radau9 (docs/simulation.md). Returns t (samples) and y, yd, u, z (one row per coordinate,
+        rate, input, output; one column per sample) with the integrator's statistics. Ctrl-C
+        stops it."""
+        q = _mbsgen.SimulationRequest()
+        q.method, q.duration, q.step, q.rtol, q.atol, q.outputs = method, float(duration), float(step), rtol, atol, outputs
+        initial = initial or {}
+        q.initial_names = list(initial)
+        q.initial_values = [float(v) for v in initial.values()]
+        specs, times, values = [""] * len(self.inputs), [np.zeros(0)] * len(self.inputs), [np.zeros(0)] * len(self.inputs)
+        for name, signal in (inputs or {}).items():
+            if name not in self.inputs:
+                raise ValueError(f"model {self.name!r} has no input {name!r} (inputs: {', '.join(self.inputs) or 'none'})")
+            j = self.inputs.index(name)
+            if isinstance(signal, str):
+                specs[j] = signal
+            elif isinstance(signal, tuple) and len(signal) == 2:
+                times[j] = np.ascontiguousarray(signal[0], dtype=np.float64)
+                values[j] = np.ascontiguousarray(signal[1], dtype=np.float64)
+                if times[j].ndim != 1 or times[j].shape != values[j].shape or times[j].size == 0:
+                    raise ValueError(f"inputs[{name!r}]: a table (times, values) of two 1-D arrays of one length")
+            else:
+                specs[j] = repr(float(signal))
+        q.input_specs, q.table_times, q.table_values = specs, times, values
+        return self._kernels.simulate(self.parameter_values(**params), q)
+
     def mass_matrix(self, y, **params: float) -> np.ndarray:
         """M(y) (a model without closed loops or rolling constraints)."""
         return self._kernels.mass_matrix(self.parameter_values(**params), self._vector("y", y))

@@ -9,6 +9,7 @@
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 #include "mbsgen/runtime/spectral/sensitivity.hpp"
+#include "mbsgen/runtime/time/simulation.hpp"
 
 #include <dlfcn.h>
 
@@ -390,6 +391,53 @@ Vector Model::accelerations(const ConstVectorRef& p, const ConstVectorRef& y, co
     throw SingularSystemError("accelerations: M(y) is singular to working precision (reciprocal condition " +
                               std::to_string(rcond) + ")");
   return lu.solve(-r);
+}
+
+Simulation Model::simulate(const ConstVectorRef& p, const SimulationRequest& q, const std::function<bool()>& stop) const {
+  const GeneratedModel model = configured(*kernels_, p);
+  const int m = kernels_->n_inputs;
+  if (q.input_specs.size() != static_cast<std::size_t>(m) || q.table_times.size() != static_cast<std::size_t>(m) ||
+      q.table_values.size() != static_cast<std::size_t>(m))
+    throw DimensionError("simulate: " + std::to_string(q.input_specs.size()) + " input signals, the model has " +
+                         std::to_string(m) + " inputs");
+  if (q.initial_names.size() != q.initial_values.size())
+    throw DimensionError("simulate: " + std::to_string(q.initial_names.size()) + " initial names and " +
+                         std::to_string(q.initial_values.size()) + " values");
+  SimulationOptions o;
+  if (q.method == "bdf") o.method = IntegrationMethod::bdf;
+  else if (q.method == "adams") o.method = IntegrationMethod::adams;
+  else if (q.method == "radau") o.method = IntegrationMethod::radau;
+  else if (q.method == "radau9") o.method = IntegrationMethod::radau9;
+  else throw NameError("simulate: method '" + q.method + "' is none of bdf, adams, radau, radau9");
+  o.duration = q.duration;
+  o.step = q.step > 0 ? q.step : q.duration / 1000;
+  o.rtol = q.rtol;
+  o.atol = q.atol;
+  for (std::size_t i = 0; i < q.initial_names.size(); ++i) o.initial.emplace_back(q.initial_names[i], q.initial_values[i]);
+  bool any = false;
+  for (int j = 0; j < m; ++j) {
+    const auto J = static_cast<std::size_t>(j);
+    if (q.table_times[J].size() > 0) {
+      o.inputs.push_back(InputSignal::table(std::vector<double>(q.table_times[J].data(), q.table_times[J].data() + q.table_times[J].size()),
+                                            std::vector<double>(q.table_values[J].data(), q.table_values[J].data() + q.table_values[J].size())));
+    } else {
+      o.inputs.push_back(q.input_specs[J].empty() ? InputSignal() : InputSignal::parse(q.input_specs[J], q.duration));
+    }
+    any = any || !o.inputs.back().is_zero();
+  }
+  if (!any) o.inputs.clear();
+  o.outputs = q.outputs;
+  if (stop) o.progress = [&stop](double) {
+    if (stop()) throw Stopped();
+  };
+  const SimulationResult r = mbsgen::simulate(model, model.operating_point(), o);
+  Simulation s;
+  s.t = r.t, s.y = r.y, s.yd = r.yd, s.u = r.u, s.z = r.z;
+  s.analytic_jacobian = r.analytic_jacobian;
+  s.constraint_drift = r.constraint_drift;
+  s.steps = r.steps, s.rhs_evaluations = r.rhs_evaluations, s.jacobian_evaluations = r.jacobian_evaluations;
+  s.error_test_failures = r.error_test_failures, s.nonlinear_failures = r.nonlinear_failures;
+  return s;
 }
 
 Modes modes_of(const ConstMatrixRef& M, const ConstMatrixRef& Q, const ConstMatrixRef& K, bool all) {

@@ -84,6 +84,29 @@ struct ResponseSensitivity {
   Vector parameter_values;
 };
 
+/// A simulation's samples (columns are times) and the integrator's statistics.
+struct Simulation {
+  Vector t;
+  Matrix y, yd, u, z;  // coordinates, rates, inputs, outputs × samples (z: 0 rows without outputs)
+  bool analytic_jacobian = false;
+  double constraint_drift = 0;
+  long steps = 0, rhs_evaluations = 0, jacobian_evaluations = 0, error_test_failures = 0, nonlinear_failures = 0;
+};
+
+/// What simulate integrates: the method (bdf, adams, radau, radau9), the span and sampling, the
+/// tolerances, initial values by name (`phi`, `phi_dot`), and one signal per input: a
+/// command-line form (`sine:1,5`, `step:2,0.1`, a number; "" is zero) or a table of times and
+/// values (table_times[j] non-empty).
+struct SimulationRequest {
+  std::string method = "bdf";
+  double duration = 1, step = 0, rtol = 1e-8, atol = 1e-10;
+  std::vector<std::string> initial_names;
+  std::vector<double> initial_values;
+  std::vector<std::string> input_specs;
+  std::vector<Vector> table_times, table_values;
+  bool outputs = true;
+};
+
 /// One response per parameter set: row k of values for set k, NaN where the set failed.
 struct BatchResponse {
   Eigen::MatrixXcd values;
@@ -151,6 +174,11 @@ class Model {
                           const std::function<bool()>& stop = {}) const;
   /// The outputs at the operating point.
   Vector outputs(const ConstVectorRef& p) const;
+  /// Integrates the nonlinear equations of motion from the operating point (runtime/time/
+  /// simulation.hpp); stop (may be empty) is asked after each sample, and Stopped thrown when it
+  /// says true.
+  Simulation simulate(const ConstVectorRef& p, const SimulationRequest& request,
+                      const std::function<bool()>& stop = {}) const;
   /// M(y) and the accelerations ÿ = −M(y)⁻¹ r(y, ẏ, u) of the equations of motion M ÿ + r = 0
   /// (r = k − q, the `residual` kernel): the right-hand side an integrator calls. A model with
   /// closed loops or rolling constraints has no such explicit form here (Error); DimensionError

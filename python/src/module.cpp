@@ -99,6 +99,34 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def_readonly("parameters", &ResponseSensitivity::parameters)
       .def_readonly("parameter_values", &ResponseSensitivity::parameter_values);
 
+  py::class_<Simulation>(m, "Simulation")
+      .def_readonly("t", &Simulation::t)
+      .def_readonly("y", &Simulation::y)
+      .def_readonly("yd", &Simulation::yd)
+      .def_readonly("u", &Simulation::u)
+      .def_readonly("z", &Simulation::z)
+      .def_readonly("analytic_jacobian", &Simulation::analytic_jacobian)
+      .def_readonly("constraint_drift", &Simulation::constraint_drift)
+      .def_readonly("steps", &Simulation::steps)
+      .def_readonly("rhs_evaluations", &Simulation::rhs_evaluations)
+      .def_readonly("jacobian_evaluations", &Simulation::jacobian_evaluations)
+      .def_readonly("error_test_failures", &Simulation::error_test_failures)
+      .def_readonly("nonlinear_failures", &Simulation::nonlinear_failures);
+
+  py::class_<SimulationRequest>(m, "SimulationRequest")
+      .def(py::init<>())
+      .def_readwrite("method", &SimulationRequest::method)
+      .def_readwrite("duration", &SimulationRequest::duration)
+      .def_readwrite("step", &SimulationRequest::step)
+      .def_readwrite("rtol", &SimulationRequest::rtol)
+      .def_readwrite("atol", &SimulationRequest::atol)
+      .def_readwrite("initial_names", &SimulationRequest::initial_names)
+      .def_readwrite("initial_values", &SimulationRequest::initial_values)
+      .def_readwrite("input_specs", &SimulationRequest::input_specs)
+      .def_readwrite("table_times", &SimulationRequest::table_times)
+      .def_readwrite("table_values", &SimulationRequest::table_values)
+      .def_readwrite("outputs", &SimulationRequest::outputs);
+
   py::class_<BatchResponse>(m, "BatchResponse")
       .def_readonly("values", &BatchResponse::values)
       .def_readonly("failed", &BatchResponse::failed)
@@ -150,6 +178,21 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def("frf_sensitivity", &Model::frf_sensitivity, py::arg("p"), py::arg("input"), py::arg("output"),
            py::arg("hz"), py::arg("names"), released)
       .def("outputs", &Model::outputs, py::arg("p"), released)
+      .def(
+          "simulate",
+          [](const Model& model, const ConstVectorRef& p, const SimulationRequest& request) {
+            const auto interrupted = [] {
+              py::gil_scoped_acquire gil;
+              return PyErr_CheckSignals() != 0;
+            };
+            try {
+              return model.simulate(p, request, interrupted);
+            } catch (const Stopped&) {
+              py::gil_scoped_acquire gil;
+              throw py::error_already_set();
+            }
+          },
+          py::arg("p"), py::arg("request"), released)
       .def("mass_matrix", &Model::mass_matrix, py::arg("p"), py::arg("y"))
       .def("accelerations", &Model::accelerations, py::arg("p"), py::arg("y"), py::arg("yd"), py::arg("u"));
 
