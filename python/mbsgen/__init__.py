@@ -270,6 +270,16 @@ class Model:
             raise ValueError("params: give the values either in params or by keyword, not both")
         return sets
 
+    def sweep(self, parameter: str, start: float, stop: float, points: int = 51, relative_tolerance: float = 1e-14,
+              **params: float):
+        """The eigenvalues at `points` values of `parameter` from start to stop (linear), the others
+        at their defaults or as given, and every value where the stability changes, refined by
+        bisection to relative_tolerance (the verdicts respect each eigenvalue's error bound):
+        values, eigenvalues (a row per value, NaN-padded), zeros, abscissa, stability;
+        boundary_values, boundary_tolerances, becomes_unstable, boundary_eigenvalues, below, above."""
+        return self._kernels.sweep(self.parameter_values(**params), parameter, float(start), float(stop), int(points),
+                                   float(relative_tolerance))
+
     def simulate(self, duration: float, step: float = 0.0, initial: Optional[Dict[str, float]] = None,
                  inputs: Optional[Dict[str, object]] = None, method: str = "bdf", rtol: float = 1e-8,
                  atol: float = 1e-10, outputs: bool = True, **params: float):

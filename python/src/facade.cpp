@@ -8,6 +8,7 @@
 #include "mbsgen/runtime/spectral/descriptor_eigen.hpp"
 #include "mbsgen/runtime/spectral/frequency_response.hpp"
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
+#include "mbsgen/runtime/spectral/parameter_sweep.hpp"
 #include "mbsgen/runtime/spectral/sensitivity.hpp"
 #include "mbsgen/runtime/time/simulation.hpp"
 
@@ -391,6 +392,44 @@ Vector Model::accelerations(const ConstVectorRef& p, const ConstVectorRef& y, co
     throw SingularSystemError("accelerations: M(y) is singular to working precision (reciprocal condition " +
                               std::to_string(rcond) + ")");
   return lu.solve(-r);
+}
+
+Sweep Model::sweep(const ConstVectorRef& p, const std::string& parameter, double from, double to, int points,
+                   double relative_tolerance) const {
+  GeneratedModel model = configured(*kernels_, p);
+  SweepOptions o;
+  o.relative_tolerance = relative_tolerance;
+  const SweepResult r = sweep_parameter(model, parameter, from, to, points, o);
+  Sweep s;
+  const auto n = static_cast<Eigen::Index>(r.points.size());
+  std::size_t widest = 0;
+  for (const SweepPoint& q : r.points) widest = std::max(widest, q.eigenvalues.size());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  s.values.resize(n);
+  s.abscissa.resize(n);
+  s.eigenvalues.setConstant(n, static_cast<Eigen::Index>(widest), std::complex<double>(nan, nan));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const SweepPoint& q = r.points[static_cast<std::size_t>(i)];
+    s.values[i] = q.value;
+    s.abscissa[i] = q.abscissa;
+    s.zeros.push_back(static_cast<long>(q.zeros));
+    s.stability.emplace_back(to_string(q.stability));
+    for (std::size_t k = 0; k < q.eigenvalues.size(); ++k) s.eigenvalues(i, static_cast<Eigen::Index>(k)) = q.eigenvalues[k];
+  }
+  const auto b = static_cast<Eigen::Index>(r.boundaries.size());
+  s.boundary_values.resize(b);
+  s.boundary_tolerances.resize(b);
+  s.boundary_eigenvalues.resize(b);
+  for (Eigen::Index i = 0; i < b; ++i) {
+    const StabilityBoundary& q = r.boundaries[static_cast<std::size_t>(i)];
+    s.boundary_values[i] = q.value;
+    s.boundary_tolerances[i] = q.tolerance;
+    s.boundary_eigenvalues[i] = q.eigenvalue;
+    s.becomes_unstable.push_back(q.becomes_unstable ? 1 : 0);
+    s.below.emplace_back(to_string(q.below));
+    s.above.emplace_back(to_string(q.above));
+  }
+  return s;
 }
 
 Simulation Model::simulate(const ConstVectorRef& p, const SimulationRequest& q, const std::function<bool()>& stop) const {

@@ -107,6 +107,21 @@ struct SimulationRequest {
   bool outputs = true;
 };
 
+/// Eigenvalues against a parameter and the values where the stability changes
+/// (runtime/spectral/parameter_sweep.hpp). eigenvalues: one row per value, the finite eigenvalues
+/// (both members of a pair) in the solver's order, NaN after a row's last.
+struct Sweep {
+  Vector values;
+  Eigen::MatrixXcd eigenvalues;
+  std::vector<long> zeros;  // per value: how many of the first eigenvalues are exact (deflated) zeros
+  Vector abscissa;          // max Re λ respecting the error bounds (−∞: none)
+  std::vector<std::string> stability;
+  Vector boundary_values, boundary_tolerances;
+  std::vector<int> becomes_unstable;
+  Eigen::VectorXcd boundary_eigenvalues;
+  std::vector<std::string> below, above;
+};
+
 /// One response per parameter set: row k of values for set k, NaN where the set failed.
 struct BatchResponse {
   Eigen::MatrixXcd values;
@@ -174,6 +189,9 @@ class Model {
                           const std::function<bool()>& stop = {}) const;
   /// The outputs at the operating point.
   Vector outputs(const ConstVectorRef& p) const;
+  /// `parameter` from `from` to `to` at `points` values (linear), the others at p.
+  Sweep sweep(const ConstVectorRef& p, const std::string& parameter, double from, double to, int points,
+              double relative_tolerance) const;
   /// Integrates the nonlinear equations of motion from the operating point (runtime/time/
   /// simulation.hpp); stop (may be empty) is asked after each sample, and Stopped thrown when it
   /// says true.

@@ -99,6 +99,19 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def_readonly("parameters", &ResponseSensitivity::parameters)
       .def_readonly("parameter_values", &ResponseSensitivity::parameter_values);
 
+  py::class_<Sweep>(m, "Sweep")
+      .def_readonly("values", &Sweep::values)
+      .def_readonly("eigenvalues", &Sweep::eigenvalues)
+      .def_readonly("zeros", &Sweep::zeros)
+      .def_readonly("abscissa", &Sweep::abscissa)
+      .def_readonly("stability", &Sweep::stability)
+      .def_readonly("boundary_values", &Sweep::boundary_values)
+      .def_readonly("boundary_tolerances", &Sweep::boundary_tolerances)
+      .def_readonly("becomes_unstable", &Sweep::becomes_unstable)
+      .def_readonly("boundary_eigenvalues", &Sweep::boundary_eigenvalues)
+      .def_readonly("below", &Sweep::below)
+      .def_readonly("above", &Sweep::above);
+
   py::class_<Simulation>(m, "Simulation")
       .def_readonly("t", &Simulation::t)
       .def_readonly("y", &Simulation::y)
@@ -178,6 +191,8 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def("frf_sensitivity", &Model::frf_sensitivity, py::arg("p"), py::arg("input"), py::arg("output"),
            py::arg("hz"), py::arg("names"), released)
       .def("outputs", &Model::outputs, py::arg("p"), released)
+      .def("sweep", &Model::sweep, py::arg("p"), py::arg("parameter"), py::arg("start"), py::arg("stop"),
+           py::arg("points"), py::arg("relative_tolerance") = 1e-14, released)
       .def(
           "simulate",
           [](const Model& model, const ConstVectorRef& p, const SimulationRequest& request) {

@@ -385,3 +385,15 @@ class TestSimulation:
             m.simulate(1.0, method="euler")
         with pytest.raises(ValueError, match="psi"):
             m.simulate(1.0, initial={"psi": 0.1})
+
+
+def test_the_bicycles_stability_boundaries():
+    # [Meijaard2007] (docs/test-references.md, recomputed at 40 digits): weave speed
+    # 4.29238253634111 m/s, capsize speed 6.02426201538837 m/s. Each boundary states its own
+    # bracket; the reference must lie inside it.
+    s = model("models/bicycle/whipple_benchmark.yaml", "full").sweep("v", 0, 10, 11)
+    assert list(s.becomes_unstable) == [0, 1]
+    for value, tolerance, expected in zip(s.boundary_values, s.boundary_tolerances,
+                                          (4.29238253634111, 6.02426201538837)):
+        assert abs(value - expected) <= tolerance <= 1e-8
+    assert s.eigenvalues.shape[0] == 11 and s.stability[5] == "marginal"
