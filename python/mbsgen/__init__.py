@@ -270,6 +270,30 @@ class Model:
             raise ValueError("params: give the values either in params or by keyword, not both")
         return sets
 
+    def study(self, parameters: Dict[str, tuple], samples: int = 100, design: str = "latin-hypercube", seed: int = 1,
+              modes: int = 0, input: str = "", output: str = "", frequencies=None, at=None, method: str = "auto",
+              threads: int = 0, bootstrap: int = 1000, **params: float):
+        """A parameter study on every core (docs/studies.md): parameters maps a name to
+        ("uniform", lo, hi), ("normal", mean, sd) or ("lognormal", median, factor); design
+        "monte-carlo", "latin-hypercube" or "saltelli" (Sobol' indices; samples is then the base
+        size N, N·(d+2) evaluations). Each evaluation records the lowest `modes` natural
+        frequencies and damping ratios, and with input and output the response magnitude at
+        `frequencies` (Hz: the rows of `sweep`) and its level in dB at `at` (scalars). Returns
+        samples (evaluations × parameters), scalar_names, scalars, sweep, failed and reasons, and
+        for a Saltelli design the indices first, total and their 95 % bounds (scalars × parameters).
+        The same seed gives the same numbers as `mbsgen run … -- study`."""
+        q = _mbsgen.StudyRequest()
+        texts = []
+        for name, spec in parameters.items():
+            if not isinstance(spec, tuple) or len(spec) != 3:
+                raise ValueError(f"parameters[{name!r}]: (kind, a, b) with kind uniform, normal or lognormal, not {spec!r}")
+            texts.append(f"{name}={spec[0]}:{float(spec[1])!r}:{float(spec[2])!r}")
+        q.parameters, q.design, q.samples, q.seed, q.modes = texts, design, int(samples), int(seed), int(modes)
+        q.input, q.output, q.method, q.threads, q.bootstrap = input, output, method, int(threads), int(bootstrap)
+        q.sweep_hz = np.zeros(0) if frequencies is None else _frequencies(frequencies)
+        q.at_hz = np.zeros(0) if at is None else _frequencies(at)
+        return self._kernels.study(self.parameter_values(**params), q)
+
     def sweep(self, parameter: str, start: float, stop: float, points: int = 51, relative_tolerance: float = 1e-14,
               **params: float):
         """The eigenvalues at `points` values of `parameter` from start to stop (linear), the others

@@ -10,6 +10,8 @@
 #include "mbsgen/runtime/spectral/quadratic_eigen.hpp"
 #include "mbsgen/runtime/spectral/parameter_sweep.hpp"
 #include "mbsgen/runtime/spectral/sensitivity.hpp"
+#include "mbsgen/runtime/study/study.hpp"
+#include "mbsgen/runtime/study/study_design.hpp"
 #include "mbsgen/runtime/time/simulation.hpp"
 
 #include <dlfcn.h>
@@ -428,6 +430,53 @@ Sweep Model::sweep(const ConstVectorRef& p, const std::string& parameter, double
     s.becomes_unstable.push_back(q.becomes_unstable ? 1 : 0);
     s.below.emplace_back(to_string(q.below));
     s.above.emplace_back(to_string(q.above));
+  }
+  return s;
+}
+
+Study Model::study(const ConstVectorRef& p, const StudyRequest& q) const {
+  const GeneratedModel model = configured(*kernels_, p);
+  std::vector<ParameterDistribution> distributions;
+  for (const std::string& text : q.parameters) distributions.push_back(parse_distribution(text));
+  if (q.samples < 1) throw DimensionError("study: samples must be at least 1, not " + std::to_string(q.samples));
+  const StudyDesign design(parse_design(q.design), distributions, static_cast<std::size_t>(q.samples), q.seed);
+  StudyQuantities quantities;
+  quantities.modes = q.modes;
+  quantities.input = q.input;
+  quantities.output = q.output;
+  quantities.sweep_hz.assign(q.sweep_hz.data(), q.sweep_hz.data() + q.sweep_hz.size());
+  quantities.at_hz.assign(q.at_hz.data(), q.at_hz.data() + q.at_hz.size());
+  quantities.method = q.method;
+  const StudyResults r = evaluate(model, design, quantities, 0, design.size(), q.threads);
+  Study s;
+  const auto n = static_cast<Eigen::Index>(r.count), d = static_cast<Eigen::Index>(design.dimension());
+  for (const ParameterDistribution& dist : distributions) s.parameter_names.push_back(dist.name);
+  s.scalar_names = r.scalar_names;
+  s.samples.resize(n, d);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const std::vector<double> x = design.point(static_cast<std::size_t>(i));
+    for (Eigen::Index k = 0; k < d; ++k) s.samples(i, k) = x[static_cast<std::size_t>(k)];
+  }
+  const auto nq = static_cast<Eigen::Index>(r.scalar_names.size()), nf = static_cast<Eigen::Index>(quantities.sweep_hz.size());
+  s.scalars = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(r.scalars.data(), n, nq);
+  s.sweep = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(r.sweep.data(), n, nf);
+  for (const StudyFailure& f : r.failures) {
+    s.failed.push_back(static_cast<long>(f.index));
+    s.reasons.push_back(f.message);
+  }
+  if (design.design() == Design::saltelli) {
+    for (Matrix* m : {&s.first, &s.first_low, &s.first_high, &s.total, &s.total_low, &s.total_high}) m->resize(nq, d);
+    for (Eigen::Index j = 0; j < nq; ++j) {
+      std::vector<double> f(static_cast<std::size_t>(n));
+      for (Eigen::Index i = 0; i < n; ++i) f[static_cast<std::size_t>(i)] = s.scalars(i, j);
+      const SobolResult so = sobol_indices(f, design.base_size(), design.dimension(),
+                                           static_cast<std::size_t>(q.bootstrap), q.seed);
+      for (Eigen::Index k = 0; k < d; ++k) {
+        const SobolIndex& x = so.indices[static_cast<std::size_t>(k)];
+        s.first(j, k) = x.first, s.first_low(j, k) = x.first_low, s.first_high(j, k) = x.first_high;
+        s.total(j, k) = x.total, s.total_low(j, k) = x.total_low, s.total_high(j, k) = x.total_high;
+      }
+    }
   }
   return s;
 }

@@ -122,6 +122,33 @@ struct Sweep {
   std::vector<std::string> below, above;
 };
 
+/// A parameter study (runtime/study/study.hpp): each parameter's distribution in the command
+/// line's form ("NAME=uniform:LO:HI", "NAME=normal:MEAN:SD", "NAME=lognormal:MEDIAN:FACTOR"), the
+/// design ("monte-carlo", "latin-hypercube", "saltelli"), what each evaluation records.
+struct StudyRequest {
+  std::vector<std::string> parameters;
+  std::string design = "monte-carlo";
+  long samples = 100;
+  unsigned long long seed = 1;
+  int modes = 0;
+  std::string input, output, method = "auto";
+  Vector sweep_hz, at_hz;
+  int threads = 0;
+  long bootstrap = 1000;  // Saltelli: resamples of the Sobol' indices' intervals
+};
+
+/// Its results, a row per evaluation: the parameter values, the scalars (f1_hz, zeta1, …,
+/// L_<f>Hz_dB), the response magnitude at sweep_hz; NaN where an evaluation failed. With a
+/// Saltelli design, the Sobol' indices of every scalar (scalars × parameters) with the bounds of
+/// their 95 % bootstrap intervals.
+struct Study {
+  std::vector<std::string> parameter_names, scalar_names;
+  Matrix samples, scalars, sweep;
+  std::vector<long> failed;
+  std::vector<std::string> reasons;
+  Matrix first, first_low, first_high, total, total_low, total_high;
+};
+
 /// One response per parameter set: row k of values for set k, NaN where the set failed.
 struct BatchResponse {
   Eigen::MatrixXcd values;
@@ -192,6 +219,7 @@ class Model {
   /// `parameter` from `from` to `to` at `points` values (linear), the others at p.
   Sweep sweep(const ConstVectorRef& p, const std::string& parameter, double from, double to, int points,
               double relative_tolerance) const;
+  Study study(const ConstVectorRef& p, const StudyRequest& request) const;
   /// Integrates the nonlinear equations of motion from the operating point (runtime/time/
   /// simulation.hpp); stop (may be empty) is asked after each sample, and Stopped thrown when it
   /// says true.

@@ -112,6 +112,36 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def_readonly("below", &Sweep::below)
       .def_readonly("above", &Sweep::above);
 
+  py::class_<StudyRequest>(m, "StudyRequest")
+      .def(py::init<>())
+      .def_readwrite("parameters", &StudyRequest::parameters)
+      .def_readwrite("design", &StudyRequest::design)
+      .def_readwrite("samples", &StudyRequest::samples)
+      .def_readwrite("seed", &StudyRequest::seed)
+      .def_readwrite("modes", &StudyRequest::modes)
+      .def_readwrite("input", &StudyRequest::input)
+      .def_readwrite("output", &StudyRequest::output)
+      .def_readwrite("method", &StudyRequest::method)
+      .def_readwrite("sweep_hz", &StudyRequest::sweep_hz)
+      .def_readwrite("at_hz", &StudyRequest::at_hz)
+      .def_readwrite("threads", &StudyRequest::threads)
+      .def_readwrite("bootstrap", &StudyRequest::bootstrap);
+
+  py::class_<Study>(m, "Study")
+      .def_readonly("parameter_names", &Study::parameter_names)
+      .def_readonly("scalar_names", &Study::scalar_names)
+      .def_readonly("samples", &Study::samples)
+      .def_readonly("scalars", &Study::scalars)
+      .def_readonly("sweep", &Study::sweep)
+      .def_readonly("failed", &Study::failed)
+      .def_readonly("reasons", &Study::reasons)
+      .def_readonly("first", &Study::first)
+      .def_readonly("first_low", &Study::first_low)
+      .def_readonly("first_high", &Study::first_high)
+      .def_readonly("total", &Study::total)
+      .def_readonly("total_low", &Study::total_low)
+      .def_readonly("total_high", &Study::total_high);
+
   py::class_<Simulation>(m, "Simulation")
       .def_readonly("t", &Simulation::t)
       .def_readonly("y", &Simulation::y)
@@ -191,6 +221,7 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def("frf_sensitivity", &Model::frf_sensitivity, py::arg("p"), py::arg("input"), py::arg("output"),
            py::arg("hz"), py::arg("names"), released)
       .def("outputs", &Model::outputs, py::arg("p"), released)
+      .def("study", &Model::study, py::arg("p"), py::arg("request"), released)
       .def("sweep", &Model::sweep, py::arg("p"), py::arg("parameter"), py::arg("start"), py::arg("stop"),
            py::arg("points"), py::arg("relative_tolerance") = 1e-14, released)
       .def(

@@ -397,3 +397,25 @@ def test_the_bicycles_stability_boundaries():
                                           (4.29238253634111, 6.02426201538837)):
         assert abs(value - expected) <= tolerance <= 1e-8
     assert s.eigenvalues.shape[0] == 11 and s.stability[5] == "marginal"
+
+
+def test_a_study_equals_the_command_lines(tmp_path):
+    # The same design, seed and quantities: every evaluation bit for bit (the CSV's 17 digits).
+    path = "models/textbook/double_pendulum.yaml"
+    m = model(path, "full")
+    hz = [0.1, 0.31622776601683794, 1.0]
+    s = m.study({"m1": ("uniform", 0.5, 1.5), "l2": ("normal", 1.0, 0.1)}, samples=20, design="latin-hypercube",
+                seed=7, modes=2, input="F", output="tip_x", frequencies=hz, at=[0.5])
+    csv_path = tmp_path / "samples.csv"
+    done = subprocess.run([TOOL, "run", os.path.join(SOURCE, path), "--", "study", "--parameter", "m1=uniform:0.5:1.5",
+                           "--parameter", "l2=normal:1.0:0.1", "--samples", "20", "--design", "lhs", "--seed", "7",
+                           "--modes", "2", "--input", "F", "--output", "tip_x", "--at", "0.5", "--from", "0.1",
+                           "--to", "1", "--points", "3",
+                           "--write-samples", str(csv_path)], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+    rows = [line.split(",") for line in csv_path.read_text().splitlines() if not line.startswith("#")][1:]
+    assert len(rows) == 20 and s.scalar_names == ["f1_hz", "zeta1", "f2_hz", "zeta2", "L_0.5Hz_dB"]
+    for i, row in enumerate(rows):
+        assert [float(x) for x in row[1:3]] == list(s.samples[i])
+        assert [float(x) for x in row[3:8]] == list(s.scalars[i])
+    assert s.sweep.shape == (20, 3) and not s.failed
