@@ -1,5 +1,5 @@
 # Type hints of the mbsgen package (docs/python.md).
-from typing import List, NamedTuple, Optional, Sequence
+from typing import Any, Dict, List, NamedTuple, Optional, Sequence
 
 import numpy as np
 
@@ -24,6 +24,11 @@ class Modes(NamedTuple):
     shapes: np.ndarray
     stability: str
     method: str
+
+class BatchResponse(NamedTuple):
+    frequencies_hz: np.ndarray
+    values: np.ndarray
+    failures: List[tuple]
 
 class Response(NamedTuple):
     frequencies_hz: np.ndarray
@@ -80,6 +85,15 @@ class Model:
     def modes(self, all: bool = False, **params: float) -> Modes: ...
     def frf(self, input: str, output: str, frequencies: Sequence[float], method: str = "auto", params=None,
             threads: int = 0, **values: float): ...
+    def study(self, parameters: Dict[str, tuple], samples: int = 100, design: str = "latin-hypercube", seed: int = 1,
+              modes: int = 0, input: str = "", output: str = "", frequencies: Optional[Sequence[float]] = None,
+              at: Optional[Sequence[float]] = None, method: str = "auto", threads: int = 0, bootstrap: int = 1000,
+              **params: float) -> Any: ...
+    def sweep(self, parameter: str, start: float, stop: float, points: int = 51, relative_tolerance: float = 1e-14,
+              **params: float) -> Any: ...
+    def simulate(self, duration: float, step: float = 0.0, initial: Optional[Dict[str, float]] = None,
+                 inputs: Optional[Dict[str, object]] = None, method: str = "bdf", rtol: float = 1e-8,
+                 atol: float = 1e-10, outputs: bool = True, **params: float) -> Any: ...
     def mass_matrix(self, y: Sequence[float], **params: float) -> np.ndarray: ...
     def accelerations(self, y: Sequence[float], yd: Sequence[float], u: Optional[Sequence[float]] = None,
                       **params: float) -> np.ndarray: ...

@@ -16,27 +16,12 @@
 namespace py = pybind11;
 using namespace mbsgen::python;
 
-PYBIND11_MODULE(_mbsgen, m) {
-  m.doc() = "mbsgen's runtime from Python: models loaded from tapes, modes and frequency responses";
-  m.attr("__version__") = mbsgen::kRuntimeVersion;
+namespace {
 
-  // mbsgen::Error and its kinds. A bad value from the caller (an unknown name, a wrong size, a NaN,
-  // a negative mass) is a ValueError; the rest (a damaged tape, no equilibrium, LAPACK) an Error.
-  static py::exception<mbsgen::Error> error(m, "Error", PyExc_RuntimeError);
-  py::register_exception_translator([](std::exception_ptr p) {
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const mbsgen::NameError& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
-    } catch (const mbsgen::DimensionError& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
-    } catch (const mbsgen::NonFiniteError& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
-    } catch (const mbsgen::Error& e) {
-      error(e.what());
-    }
-  });
+const auto released = py::call_guard<py::gil_scoped_release>();
 
+// The results of the model's analyses, read-only.
+void bind_results(py::module_& m) {
   py::class_<Linear>(m, "Linear")
       .def_readonly("descriptor", &Linear::descriptor)
       .def_readonly("M", &Linear::M)
@@ -99,6 +84,10 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def_readonly("parameters", &ResponseSensitivity::parameters)
       .def_readonly("parameter_values", &ResponseSensitivity::parameter_values);
 
+}
+
+// Sweeps, studies and simulations: their requests and results.
+void bind_analyses(py::module_& m) {
   py::class_<Sweep>(m, "Sweep")
       .def_readonly("values", &Sweep::values)
       .def_readonly("eigenvalues", &Sweep::eigenvalues)
@@ -175,7 +164,9 @@ PYBIND11_MODULE(_mbsgen, m) {
       .def_readonly("failed", &BatchResponse::failed)
       .def_readonly("reasons", &BatchResponse::reasons);
 
-  const auto released = py::call_guard<py::gil_scoped_release>();
+}
+
+void bind_model(py::module_& m) {
   py::class_<Model>(m, "Model")
       .def(py::init<const std::string&>(), py::arg("path"), released)
       .def_property_readonly("name", &Model::name)
@@ -244,6 +235,10 @@ PYBIND11_MODULE(_mbsgen, m) {
 
   // For bench/python_bench.py: the same facade calls timed in C++ (n calls in a row, seconds in
   // all), so that the Python overhead per call is a difference measured in one process.
+}
+
+// The analyses of matrices, and the facade's calls timed in C++.
+void bind_functions(py::module_& m) {
   auto timing = m.def_submodule("_timing", "the facade's calls timed in C++ (bench/python_bench.py)");
   timing.def(
       "linear", [](const Model& model, const Vector& p, int n) {
@@ -264,4 +259,33 @@ PYBIND11_MODULE(_mbsgen, m) {
   m.def("modes_of", &modes_of, py::arg("M"), py::arg("Q"), py::arg("K"), py::arg("all") = false, released);
   m.def("frf_of", &frf_of, py::arg("M"), py::arg("Q"), py::arg("K"), py::arg("B"), py::arg("C_y"), py::arg("C_v"),
         py::arg("input"), py::arg("output"), py::arg("hz"), py::arg("method") = "auto", released);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_mbsgen, m) {
+  m.doc() = "mbsgen's runtime from Python: models loaded from tapes, modes and frequency responses";
+  m.attr("__version__") = mbsgen::kRuntimeVersion;
+
+  // mbsgen::Error and its kinds. A bad value from the caller (an unknown name, a wrong size, a NaN,
+  // a negative mass) is a ValueError; the rest (a damaged tape, no equilibrium, LAPACK) an Error.
+  static py::exception<mbsgen::Error> error(m, "Error", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const mbsgen::NameError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const mbsgen::DimensionError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const mbsgen::NonFiniteError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const mbsgen::Error& e) {
+      error(e.what());
+    }
+  });
+
+  bind_results(m);
+  bind_analyses(m);
+  bind_model(m);
+  bind_functions(m);
 }
