@@ -170,6 +170,7 @@ class Model:
         self.parameters: List[Parameter] = [
             Parameter(n, float(d), u) for n, d, u in zip(names, self._kernels.parameter_defaults, self._kernels.parameter_units)]
         self._defaults = np.array([q.default for q in self.parameters], dtype=np.float64)
+        self._defaults.flags.writeable = False  # passed as is to calls without parameters
         self.coordinates: List[str] = list(self._kernels.coordinate_names)
         self.coordinate_units: List[str] = list(self._kernels.coordinate_units)
         self.inputs: List[str] = list(self._kernels.input_names)
@@ -186,6 +187,11 @@ class Model:
 
     def parameter_values(self, **params: float) -> np.ndarray:
         """Every parameter's value in the model's order: the defaults, with the given ones set."""
+        return self._values(params).copy()
+
+    def _values(self, params) -> np.ndarray:
+        if not params:
+            return self._defaults
         p = self._defaults.copy()
         for name, value in params.items():
             i = self._index.get(name)
@@ -200,7 +206,7 @@ class Model:
 
     def operating_point(self, **params: float):
         """y0, yd0 and how they were found (given by the model, or a static equilibrium)."""
-        return self._kernels.operating_point(self.parameter_values(**params))
+        return self._kernels.operating_point(self._values(params))
 
     def static(self, **params: float):
         """The static equilibrium (or the model's given operating point): as operating_point."""
@@ -209,11 +215,11 @@ class Model:
     def linear(self, **params: float):
         """The linear model at the operating point: M, Q, K, B, C_y, C_v (and C_a, D, B1, B2, D1,
         0×0 when zero) as NumPy arrays; for a model with rolling constraints E, A, B, C, D."""
-        return self._kernels.linear(self.parameter_values(**params))
+        return self._kernels.linear(self._values(params))
 
     def modes(self, all: bool = False, **params: float) -> Modes:
         """The eigenvalues of the linear model (see Modes)."""
-        return _modes(self._kernels.modes(self.parameter_values(**params), all))
+        return _modes(self._kernels.modes(self._values(params), all))
 
     def frf(self, input: str, output: str, frequencies: Sequence[float], method: str = "auto", params=None,
             threads: int = 0, **values: float):
@@ -226,7 +232,7 @@ class Model:
         as given by keyword). Returns a BatchResponse."""
         hz = _frequencies(frequencies)
         if params is None:
-            r = self._kernels.frf(self.parameter_values(**values), input, output, hz, method)
+            r = self._kernels.frf(self._values(values), input, output, hz, method)
             return Response(hz, r.values, r.rcond, list(r.flags), list(r.warnings), r.method)
         b = self._kernels.frf_batch(self.parameter_sets(params, **values), input, output, hz, method, int(threads))
         return BatchResponse(hz, b.values, list(zip(b.failed, b.reasons)))
@@ -237,14 +243,14 @@ class Model:
         parameters, parameter_values, dlambda (modes × parameters, 1/s per unit), dfrequency_hz,
         relative_frequency ((p/f) df/dp), ddamping_ratio, and notes (why a mode's derivative is
         not defined: repeated, defective, zero, infinite; its entries are NaN)."""
-        return self._kernels.modes_sensitivity(self.parameter_values(**values), list(parameters or []))
+        return self._kernels.modes_sensitivity(self._values(values), list(parameters or []))
 
     def frf_sensitivity(self, input: str, output: str, frequencies: Sequence[float],
                         parameters: Optional[Sequence[str]] = None, **values: float):
         """The response and dz/dp by the named parameters (all when None) at `frequencies` (Hz):
         values, derivatives (parameters × frequencies), rcond, parameters, parameter_values."""
         hz = _frequencies(frequencies)
-        return self._kernels.frf_sensitivity(self.parameter_values(**values), input, output, hz, list(parameters or []))
+        return self._kernels.frf_sensitivity(self._values(values), input, output, hz, list(parameters or []))
 
     def parameter_sets(self, params, **values: float) -> np.ndarray:
         """params (an array of shape (n_sets, len(parameters)), or a dict {name: n_sets values}) as
@@ -255,7 +261,7 @@ class Model:
             if len(set(lengths.values())) != 1:
                 raise ValueError(f"params: every parameter needs as many values ({lengths})")
             n = next(iter(lengths.values()))
-            sets = np.tile(self.parameter_values(**values), (n, 1))
+            sets = np.tile(self._values(values), (n, 1))
             for name, v in params.items():
                 if name not in self._index:
                     raise ValueError(f"model {self.name!r} has no parameter {name!r} "
@@ -292,7 +298,7 @@ class Model:
         q.input, q.output, q.method, q.threads, q.bootstrap = input, output, method, int(threads), int(bootstrap)
         q.sweep_hz = np.zeros(0) if frequencies is None else _frequencies(frequencies)
         q.at_hz = np.zeros(0) if at is None else _frequencies(at)
-        return self._kernels.study(self.parameter_values(**params), q)
+        return self._kernels.study(self._values(params), q)
 
     def sweep(self, parameter: str, start: float, stop: float, points: int = 51, relative_tolerance: float = 1e-14,
               **params: float):
@@ -301,7 +307,7 @@ class Model:
         bisection to relative_tolerance (the verdicts respect each eigenvalue's error bound):
         values, eigenvalues (a row per value, NaN-padded), zeros, abscissa, stability;
         boundary_values, boundary_tolerances, becomes_unstable, boundary_eigenvalues, below, above."""
-        return self._kernels.sweep(self.parameter_values(**params), parameter, float(start), float(stop), int(points),
+        return self._kernels.sweep(self._values(params), parameter, float(start), float(stop), int(points),
                                    float(relative_tolerance))
 
     def simulate(self, duration: float, step: float = 0.0, initial: Optional[Dict[str, float]] = None,
@@ -335,17 +341,17 @@ class Model:
             else:
                 specs[j] = repr(float(signal))
         q.input_specs, q.table_times, q.table_values = specs, times, values
-        return self._kernels.simulate(self.parameter_values(**params), q)
+        return self._kernels.simulate(self._values(params), q)
 
     def mass_matrix(self, y, **params: float) -> np.ndarray:
         """M(y) (a model without closed loops or rolling constraints)."""
-        return self._kernels.mass_matrix(self.parameter_values(**params), self._vector("y", y))
+        return self._kernels.mass_matrix(self._values(params), self._vector("y", y))
 
     def accelerations(self, y, yd, u=None, **params: float) -> np.ndarray:
         """ÿ = −M(y)⁻¹ (k − q)(y, ẏ, u): the right-hand side of the equations of motion, for an
         integrator (a model without closed loops or rolling constraints; u None: zero inputs)."""
         u = np.zeros(len(self.inputs)) if u is None else u
-        return self._kernels.accelerations(self.parameter_values(**params), self._vector("y", y),
+        return self._kernels.accelerations(self._values(params), self._vector("y", y),
                                            self._vector("yd", yd), self._vector("u", u))
 
     @staticmethod
@@ -357,7 +363,7 @@ class Model:
 
     def output_values(self, **params: float) -> np.ndarray:
         """The outputs at the operating point."""
-        return self._kernels.outputs(self.parameter_values(**params))
+        return self._kernels.outputs(self._values(params))
 
 
 class linear:  # noqa: N801 (a namespace: mbsgen.linear.modes, mbsgen.linear.frf)
