@@ -60,7 +60,10 @@ def tool() -> str:
 
 def _cached(command: str, path: str, scene: Optional[str]):
     """`mbsgen tape|kernels PATH [--scene SCENE]`: (exit code, the artifact's path, the messages)."""
-    # The generator as a separate program, its arguments a list: nothing goes through a shell.
+    # The generator as a separate program, its arguments a list: nothing goes through a shell. A
+    # path that starts with "-" would read as an option: it is given as ./-….
+    if path.startswith("-"):
+        path = os.path.join(".", path)
     args = [tool(), command, path]
     if scene is not None:
         args += ["--scene", scene]

@@ -419,3 +419,11 @@ def test_a_study_equals_the_command_lines(tmp_path):
         assert [float(x) for x in row[1:3]] == list(s.samples[i])
         assert [float(x) for x in row[3:8]] == list(s.scalars[i])
     assert s.sweep.shape == (20, 3) and not s.failed
+
+
+def test_a_model_file_named_like_an_option(tmp_path, monkeypatch):
+    # A file name is data: "-h.yaml" must be read as a file, not taken for --help.
+    source = os.path.join(SOURCE, "models/textbook/simple_pendulum.yaml")
+    (tmp_path / "-h.yaml").write_text(open(source, encoding="utf-8").read())
+    monkeypatch.chdir(tmp_path)
+    assert mbsgen.Model("-h.yaml").name == "simple_pendulum"
