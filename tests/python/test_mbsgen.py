@@ -427,3 +427,27 @@ def test_a_model_file_named_like_an_option(tmp_path, monkeypatch):
     (tmp_path / "-h.yaml").write_text(open(source, encoding="utf-8").read())
     monkeypatch.chdir(tmp_path)
     assert mbsgen.Model("-h.yaml").name == "simple_pendulum"
+
+
+def test_threads_share_a_model():
+    # The GIL is released in every analysis: Python threads calling one model at once must get
+    # what each gets alone (the tape's workspaces are per call).
+    import threading
+
+    m = model("models/middle_ear/middle_ear.yaml", "full")
+    hz = np.logspace(2, 4, 30)
+    values = [400.0, 700.0, 900.0, 1200.0]
+    alone = {v: m.frf("P", "v_stapes", hz, k_al_z=v).values for v in values}
+    wrong = []
+
+    def work(v):
+        for _ in range(20):
+            if not np.array_equal(m.frf("P", "v_stapes", hz, k_al_z=v).values, alone[v]):
+                wrong.append(v)
+
+    threads = [threading.Thread(target=work, args=(v,)) for v in values]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not wrong
