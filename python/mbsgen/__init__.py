@@ -317,13 +317,20 @@ class Model:
                  inputs: Optional[Dict[str, object]] = None, method: str = "bdf", rtol: float = 1e-8,
                  atol: float = 1e-10, outputs: bool = True, **params: float):
         """Integrates the nonlinear equations of motion from the operating point over [0, duration]
-        (s), sampled every `step` (default duration/1000). initial: coordinates and rates by name
+        (s), sampled every `step` (default duration/1000); duration may instead be the sample times
+        (evenly spaced from 0, e.g. np.linspace(0, 5, 501)). initial: coordinates and rates by name
         ({"phi": 0.3, "phi_dot": 0}); inputs: per input name a number, a signal in the command
         line's form ("sine:AMPLITUDE,HZ[,PHASE_DEG[,OFFSET]]", "step:AMPLITUDE[,TIME[,BEFORE]]",
         "chirp:AMPLITUDE,F0,F1[,DURATION]") or a table (times, values); method: bdf, adams, radau,
         radau9 (docs/simulation.md). Returns t (samples) and y, yd, u, z (one row per coordinate,
         rate, input, output; one column per sample) with the integrator's statistics. Ctrl-C
         stops it."""
+        if np.ndim(duration) == 1:  # sample times 0, h, 2h, …, T
+            t = np.asarray(duration, dtype=np.float64)
+            h = t[1] - t[0] if t.size > 1 else 0.0
+            if t.size < 2 or t[0] != 0 or h <= 0 or np.max(np.abs(np.diff(t) - h)) > 1e-9 * t[-1]:
+                raise ValueError("duration: a number, or the sample times 0, h, 2h, …, T (evenly spaced from 0)")
+            duration, step = t[-1], h
         q = _mbsgen.SimulationRequest()
         q.method, q.duration, q.step, q.rtol, q.atol, q.outputs = method, float(duration), float(step), rtol, atol, outputs
         initial = initial or {}

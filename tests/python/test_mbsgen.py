@@ -451,3 +451,12 @@ def test_threads_share_a_model():
     for t in threads:
         t.join()
     assert not wrong
+
+
+def test_simulate_at_given_times():
+    m = model("models/textbook/simple_pendulum.yaml", "full")
+    t = np.linspace(0, 1, 101)
+    r = m.simulate(t, initial={"phi": 0.2})
+    assert np.allclose(r.t, t, rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match="evenly spaced"):
+        m.simulate(np.array([0.0, 0.1, 0.3]))
