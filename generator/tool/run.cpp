@@ -521,18 +521,30 @@ int exec_program(const fs::path& program, std::string name, std::vector<std::str
 
 // Runs args on the model's tape (issue 40 §1: no compiler), generating and caching it first;
 // nullopt when the model has no tape (closed loops): then a compiled solver answers.
+// Makes sure model_file's tape is in its cache entry dir (generating it first; `command` names the
+// progress line), the entry locked by `lock`; 0, or the build's exit status.
+int ensure_tape(const std::string& model_file, const std::string& scene, const std::string& text, const char* command,
+                fs::path& dir, std::optional<EntryLock>& lock) {
+  dir = entry_dir(tape_key(text, scene));
+  return ensure_entry(dir, "tape", model_file, lock, [&] {
+    Progress progress(command);
+    build_tape(model_file, scene, text, dir, lock, progress);
+    return 0;
+  });
+}
+
+// Whether the tape entry dir holds a tape: an empty one stands for a model with closed loops.
+bool holds_tape(const fs::path& dir) {
+  std::error_code ec;
+  return !(fs::file_size(dir / "tape", ec) == 0 && !ec);
+}
+
 std::optional<int> run_tape(const std::string& model_file, const std::string& scene, std::vector<std::string>& args,
                             const std::string& text) {
-  const fs::path dir = entry_dir(tape_key(text, scene));
+  fs::path dir;
   std::optional<EntryLock> lock;
-  if (const int status = ensure_entry(dir, "tape", model_file, lock, [&] {
-        Progress progress("run");
-        build_tape(model_file, scene, text, dir, lock, progress);
-        return 0;
-      }))
-    return status;
-  std::error_code ec;
-  if (fs::file_size(dir / "tape", ec) == 0 && !ec) return std::nullopt;  // closed loops
+  if (const int status = ensure_tape(model_file, scene, text, "run", dir, lock)) return status;
+  if (!holds_tape(dir)) return std::nullopt;  // closed loops
   const fs::path solver = tape_solver();
   return exec_program(solver, solver.string(), {(dir / "tape").string()}, args);
 }
@@ -548,16 +560,10 @@ int tape_main(const std::string& model_file, const std::string& scene) {
 #else
   const std::string text = read_model_text(model_file);  // throws: reported by the caller, exit 1
   cache_limit();
-  const fs::path dir = entry_dir(tape_key(text, scene));
+  fs::path dir;
   std::optional<EntryLock> lock;
-  if (const int status = ensure_entry(dir, "tape", model_file, lock, [&] {
-        Progress progress("tape");
-        build_tape(model_file, scene, text, dir, lock, progress);
-        return 0;
-      }))
-    return status;
-  std::error_code ec;
-  if (fs::file_size(dir / "tape", ec) == 0 && !ec) {
+  if (const int status = ensure_tape(model_file, scene, text, "tape", dir, lock)) return status;
+  if (!holds_tape(dir)) {
     std::cerr << "mbsgen tape: " << model_file << " has closed loops, whose kernels only compiled code evaluates: no tape\n";
     return 3;
   }
