@@ -28,7 +28,7 @@ else
   packages=(cmake g++ make pkg-config libginac-dev libcln-dev libeigen3-dev libyaml-cpp-dev
             libcli11-dev libgtest-dev liblapacke-dev libopenblas-dev gnuplot-nox libjemalloc-dev
             libsundials-cvode6 libboost-dev libopenmpi-dev openmpi-bin
-            pybind11-dev python3-dev python3-numpy python3-pytest "$@")
+            pybind11-dev python3-dev python3-numpy python3-pytest libceres3 libgoogle-glog-dev "$@")
 fi
 missing=()
 for p in "${packages[@]}"; do
@@ -49,23 +49,32 @@ fi
 
 [ "$demo" = 1 ] && exit 0  # the demo's solver does not simulate: no SUNDIALS
 
-# The SUNDIALS headers of the installed library's version, unless libsundials-dev is installed.
-headers=build/deps/sundials
-version=$(dpkg-query -W -f='${Version}' libsundials-cvode6)
-if [ ! -f /usr/include/cvode/cvode.h ] && [ "$(cat "$headers/version" 2>/dev/null)" != "$version" ]; then
+# The headers of an installed library's version from its -dev package's .deb, unless that package
+# is installed: headers_from_deb DEV_PACKAGE RUNTIME_PACKAGE TEST_HEADER DIR
+headers_from_deb() {
+  local dev=$1 runtime=$2 test_header=$3 headers=$4 version work
+  version=$(dpkg-query -W -f='${Version}' "$runtime")
+  if [ -f "/usr/include/$test_header" ] || [ "$(cat "$headers/version" 2>/dev/null)" = "$version" ]; then
+    return 0
+  fi
   work=$(mktemp -d)
-  trap 'rm -rf "$work"' EXIT
-  download() { (cd "$work" && apt-get download -qq "libsundials-dev=$version" > log 2>&1); }
+  download() { (cd "$work" && apt-get download -qq "$dev=$version" > log 2>&1); }
   if ! download && ! { [ "$(id -u)" -eq 0 ] && apt-get update -qq && download; }; then
     cat "$work/log" >&2
-    echo "mbsgen: cannot download libsundials-dev=$version for its headers (run apt-get update, or install" \
-         "libsundials-dev)" >&2
+    echo "mbsgen: cannot download $dev=$version for its headers (run apt-get update, or install $dev)" >&2
+    rm -rf "$work"
     exit 1
   fi
-  dpkg-deb -x "$work"/libsundials-dev_*.deb "$work/root"
+  dpkg-deb -x "$work"/"${dev}"_*.deb "$work/root"
   rm -rf "$headers"
   mkdir -p "$headers"
   cp -r "$work/root/usr/include" "$headers/include"
   echo "$version" > "$headers/version"
-  echo "mbsgen: SUNDIALS $version headers from libsundials-dev's package in $headers" >&2
-fi
+  rm -rf "$work"
+  echo "mbsgen: $dev $version headers from its package in $headers" >&2
+}
+headers_from_deb libsundials-dev libsundials-cvode6 cvode/cvode.h build/deps/sundials
+# Ceres Solver (the solver of `fit`, issue 42): the runtime library libceres3 and its headers;
+# libceres-dev itself depends on SuiteSparse's and ATLAS's development packages and GraphBLAS
+# (255 MB installed on Debian 12, against about 30 MB for libceres3 with glog's headers).
+headers_from_deb libceres-dev libceres3 ceres/ceres.h build/deps/ceres

@@ -132,9 +132,9 @@ int print_info(const mbsgen::Model& model, const std::vector<mbsgen::Scene>& sce
 int run_command(int argc, char** argv) {
   const char* usage =
       "usage: mbsgen run MODEL [--scene NAME] [--compiled] [--debug] -- "
-      "info|modes|frf|static|sweep|matrices|simulate|study|outputs [ARGS...]\n"
+      "info|modes|frf|static|sweep|matrices|simulate|study|outputs|fit [ARGS...]\n"
       "  generates and caches the model's kernels, then runs the solver with ARGS: info, modes, frf, static,\n"
-      "  sweep, matrices and outputs evaluate the kernels from a tape, without a compiler; simulate, study, a\n"
+      "  sweep, matrices, outputs and fit evaluate the kernels from a tape, without a compiler; simulate, study, a\n"
       "  model with closed loops and --compiled compile and cache the solver first (--debug: with the\n"
       "  runtime's debug information, for a debugger)\n"
       "  (the solver's options: mbsgen run MODEL -- --help; the cache: mbsgen cache --help)\n";

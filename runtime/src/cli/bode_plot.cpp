@@ -653,3 +653,105 @@ void write_sweep_plot(const std::string& path, const SweepResult& r, const Sweep
 }
 
 }  // namespace mbsgen::cli
+
+namespace mbsgen::cli {
+
+namespace {
+
+// The fit plot's script: data inline, one datablock of points and one of curves per series.
+std::string fit_script(const std::string& terminal, const std::vector<FitPlotSeries>& series, const FitPlot& plot) {
+  static const char* colours[] = {"#1f4e9c", "#c0392b", "#1e8449", "#7d3c98", "#b9770e", "#17a589"};
+  std::ostringstream s;
+  s << "set terminal " << terminal << "\n";
+  const auto deg = [](std::complex<double> z) { return std::arg(z) * 180.0 / kPi; };
+  double lo = 0, hi = 0;
+  // Phases unwrapped along each curve (the start's branch nearest the fit's first value), and
+  // each data point's phase on the branch nearest the fitted curve at its frequency.
+  const auto unwrap = [&](const std::vector<std::complex<double>>& z, double near) {
+    std::vector<double> out;
+    for (std::size_t i = 0; i < z.size(); ++i) {
+      double d = deg(z[i]);
+      const double ref = i == 0 ? near : out.back();
+      if (std::isfinite(ref)) d += 360.0 * std::round((ref - d) / 360.0);
+      out.push_back(d);
+    }
+    return out;
+  };
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    const FitPlotSeries& x = series[k];
+    const std::vector<double> fit = unwrap(x.fitted, NAN);
+    const std::vector<double> start = unwrap(x.initial, fit.empty() ? NAN : fit.front());
+    s << "$d" << k << " << EOD\n";
+    for (std::size_t i = 0; i < x.hz.size(); ++i) {
+      double ph = x.has_phase[i] ? deg(x.data[i]) : NAN;
+      std::size_t near = 0;
+      for (std::size_t c = 0; c < x.curve_hz.size(); ++c)
+        if (std::abs(std::log(x.curve_hz[c] / x.hz[i])) < std::abs(std::log(x.curve_hz[near] / x.hz[i]))) near = c;
+      if (std::isfinite(ph) && near < fit.size()) ph += 360.0 * std::round((fit[near] - ph) / 360.0);
+      char line[256];
+      std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g %.17g\n", x.hz[i], std::abs(x.data[i]), ph,
+                    x.residual_magnitude[i], x.residual_phase[i]);
+      s << line;
+    }
+    s << "EOD\n$c" << k << " << EOD\n";
+    for (std::size_t i = 0; i < x.curve_hz.size(); ++i) {
+      char line[256];
+      std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g %.17g\n", x.curve_hz[i], std::abs(x.initial[i]),
+                    start[i], std::abs(x.fitted[i]), fit[i]);
+      s << line;
+      lo = lo == 0 ? x.curve_hz[i] : std::min(lo, x.curve_hz[i]);
+      hi = std::max(hi, x.curve_hz[i]);
+    }
+    s << "EOD\n";
+  }
+  s << "set multiplot layout 3,1 title " << gnuplot_string(plot.title) << " noenhanced\n";
+  if (hi > lo) s << "set xrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\n";
+  s << "set logscale x\nset grid xtics ytics mxtics\nset format x '10^{%L}'\nset key outside right top box noenhanced\n"
+    << "set lmargin 12\nset rmargin 44\n";
+  const auto each = [&](const std::function<std::string(std::size_t, const std::string&)>& f) {
+    std::string out;
+    for (std::size_t k = 0; k < series.size(); ++k) {
+      const std::string c = std::string("lc rgb '") + colours[k % 6] + "'";
+      out += (k ? ", " : "") + f(k, c);
+    }
+    return out;
+  };
+  s << "set logscale y\nset format y '10^{%L}'\nset ylabel 'magnitude |output/input| [units: legend]'\n"
+    << "plot " << each([&](std::size_t k, const std::string& c) {
+         const std::string n = series[k].label;
+         return "$d" + std::to_string(k) + " using 1:2 with points pt 7 ps 1.2 " + c + " title " + gnuplot_string(n + " data") +
+                ", $c" + std::to_string(k) + " using 1:2 with lines dt 2 lw 1.5 " + c + " title " + gnuplot_string(n + " start") +
+                ", $c" + std::to_string(k) + " using 1:4 with lines lw 2 " + c + " title " + gnuplot_string(n + " fit");
+       })
+    << "\nunset logscale y\nset format y '%g'\nset ylabel 'phase [deg]'\n"
+    << "plot " << each([&](std::size_t k, const std::string& c) {
+         const std::string n = series[k].label;
+         return "$d" + std::to_string(k) + " using 1:3 with points pt 7 ps 1.2 " + c + " title " +
+                gnuplot_string(n + " data (where measured)") + ", $c" + std::to_string(k) + " using 1:3 with lines dt 2 lw 1.5 " + c +
+                " title " + gnuplot_string(n + " start") + ", $c" + std::to_string(k) + " using 1:5 with lines lw 2 " + c +
+                " title " + gnuplot_string(n + " fit");
+       })
+    << "\nset ylabel 'weighted residual [-]'\nset xlabel 'frequency [Hz]'\n"
+    << "plot " << each([&](std::size_t k, const std::string& c) {
+         const std::string n = series[k].label;
+         return "$d" + std::to_string(k) + " using 1:4 with points pt 7 " + c + " title " + gnuplot_string(n + " ln|H| residual") +
+                ", $d" + std::to_string(k) + " using 1:5 with points pt 6 " + c + " title " + gnuplot_string(n + " phase residual");
+       })
+    << ", 2 with lines dt 3 lc rgb '#777777' title '+2 (2 sigma)', -2 with lines dt 3 lc rgb '#777777' title '-2'"
+    << ", 0 with lines lc rgb '#000000' notitle\n"
+    << "unset multiplot\n";
+  return s.str();
+}
+
+}  // namespace
+
+void write_fit_plot(const std::string& path, const std::vector<FitPlotSeries>& series, const FitPlot& plot) {
+  if (series.empty()) throw DimensionError("write_fit_plot: no series");
+  for (const FitPlotSeries& x : series)
+    if (x.data.size() != x.hz.size() || x.has_phase.size() != x.hz.size() || x.residual_magnitude.size() != x.hz.size() ||
+        x.residual_phase.size() != x.hz.size() || x.initial.size() != x.curve_hz.size() || x.fitted.size() != x.curve_hz.size())
+      throw DimensionError("write_fit_plot: series '" + x.label + "' has vectors of different sizes");
+  render(path, [&](const std::string& terminal) { return fit_script(terminal, series, plot); }, "1100,1000");
+}
+
+}  // namespace mbsgen::cli

@@ -1,6 +1,7 @@
 // Bode plots through gnuplot (Debian `gnuplot-nox`): we do not render plots ourselves.
 #pragma once
 
+#include <complex>
 #include <string>
 #include <vector>
 
@@ -69,5 +70,25 @@ struct BandPlot {
 /// write_bode_plot does. DimensionError for sizes that do not fit.
 void write_band_plot(const std::string& path, const std::vector<double>& hz,
                      const std::vector<std::vector<double>>& bands, const BandPlot& plot);
+
+/// One measured frequency response of a fit (fit_cli.cpp): the data points, the model's curves
+/// at the start and at the fit, and the weighted residuals.
+struct FitPlotSeries {
+  std::string label;  // e.g. "v_stapes/P"
+  std::vector<double> hz;
+  std::vector<std::complex<double>> data;  // magnitude only where !has_phase
+  std::vector<bool> has_phase;
+  std::vector<double> residual_magnitude, residual_phase;  // NaN: none
+  std::vector<double> curve_hz;
+  std::vector<std::complex<double>> initial, fitted;  // at curve_hz
+};
+struct FitPlot {
+  std::string title;
+};
+
+/// Writes a fit's plot to `path`, as write_bode_plot does: magnitude (log–log) and phase of the
+/// data (points), the start (dashed) and the fit (solid) per series, and below the weighted
+/// residuals of magnitude and phase against frequency with the band ±2 named.
+void write_fit_plot(const std::string& path, const std::vector<FitPlotSeries>& series, const FitPlot& plot);
 
 }  // namespace mbsgen::cli

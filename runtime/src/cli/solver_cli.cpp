@@ -534,6 +534,11 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
   CLI::App* study = add_study(app, study_options);
   OutputsOptions outputs_options;
   CLI::App* outputs = add_outputs(app, outputs_options);
+  // `fit` (issue 42) runs on the model's tape, in mbsgen-fit, the one program that links Ceres
+  // Solver; a compiled solver says where to find it.
+  CLI::App* fit = app.add_subcommand("fit", "fit parameters to measured data: through `mbsgen run MODEL fit` (docs/fitting.md)");
+  fit->allow_extras();
+  fit->prefix_command();
   o.format = "table";
   try {
     app.parse(argc, argv);
@@ -570,6 +575,12 @@ int solver_main(const ModelKernels& k, int argc, char** argv, std::ostream& out,
       err << program << ": frf: " << problem << "\n";
       return 2;
     }
+  }
+  if (fit->parsed()) {
+    err << program << ": fit runs on the model's tape: `mbsgen run MODEL fit ARGS` (or `mbsgen-fit TAPE fit ARGS` with the "
+                      "path `mbsgen tape MODEL` prints); a compiled solver does not link Ceres Solver; a model with closed loops has neither a tape nor sensitivities, "
+                      "and cannot be fitted (docs/fitting.md)\n";
+    return 2;
   }
   try {
     if (info->parsed()) return run_info(k, o, out);

@@ -1,0 +1,304 @@
+// The command `fit` (issue 42; docs/fitting.md): `mbsgen run MODEL fit …` and `mbsgen-fit TAPE
+// fit …`. Reads measured data, fits named parameters (runtime/fit), prints the estimates and
+// what the data identify, and writes JSON/CSV and a plot of data, start and fit with residuals.
+#include "cli/fit_cli.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "cli/bode_plot.hpp"
+#include "cli/cli_files.hpp"
+#include "cli/cli_output.hpp"
+#include "mbsgen/runtime/model/tape.hpp"
+#include "mbsgen/runtime/spectral/sensitivity.hpp"
+
+namespace mbsgen::cli {
+
+namespace {
+
+constexpr const char* kMarker = "mbsgen fit";
+constexpr double kPi = 3.14159265358979323846;
+
+std::string label(const FitResult::Point& p) {
+  return (p.set.empty() ? "" : p.set + ": ") + p.output + "/" + p.input;
+}
+
+void write_table(std::ostream& out, const ModelKernels& k, const FitResult& f) {
+  out << "# fit of model '" << k.model << "' (scene '" << k.scene << "'): " << f.residuals << " residuals, "
+      << f.names.size() << " parameters, " << (f.converged ? "converged" : "NOT CONVERGED") << " (" << f.termination
+      << "), " << f.iterations << " iterations, " << f.evaluations << " evaluations, " << fixed(f.seconds, "%.3g") << " s\n"
+      << "# cost 1/2 sum r^2: " << short_num(f.initial_cost) << " at the start, " << short_num(f.cost) << " at the fit (data "
+      << short_num(f.data_cost) << "); s^2 = " << short_num(f.residual_variance)
+      << (f.weighted ? " (the data's standard deviations)\n" : " (estimated from the residuals: the data carry no standard deviations)\n");
+  out << pad("parameter", 20) << pad("start", 15) << pad("estimate", 15) << pad("std.error", 15) << pad("95% lower", 15)
+      << pad("95% upper", 15) << "  space   bound\n";
+  for (std::size_t j = 0; j < f.names.size(); ++j) {
+    const auto i = static_cast<Eigen::Index>(j);
+    out << pad(f.names[j], 20) << pad(short_num(f.start[i]), 15) << pad(short_num(f.values[i]), 15)
+        << pad(short_num(f.standard_error[i]), 15) << pad(short_num(f.lower95[i]), 15) << pad(short_num(f.upper95[i]), 15)
+        << "  " << (f.log_space[j] ? "log   " : "linear") << "  " << (f.at_bound[j].empty() ? "-" : f.at_bound[j]) << "\n";
+  }
+  out << "# identifiability (Fisher information of the data, relative coordinates; weakest first):\n";
+  for (const FisherDirection& d : f.fisher)
+    out << "#   " << d.verdict << ": sigma " << short_num(d.sigma) << ": " << d.description << "\n";
+  if (f.minima.size() > 1) {
+    out << "# distinct local minima (cost, starts ending there):\n";
+    for (const LocalMinimum& m : f.minima) out << "#   " << short_num(m.cost) << "  " << m.starts << "\n";
+  }
+  for (const Profile& p : f.profiles)
+    out << "# profile likelihood of " << p.parameter << ": 95 % interval [" << short_num(p.lower) << ", "
+        << short_num(p.upper) << "] (" << p.points.size() << " points; '-': not reached within the range)\n";
+  for (const std::string& w : f.warnings) out << "# warning: " << w << "\n";
+}
+
+std::string json_vector(const Eigen::VectorXd& v) {
+  std::string s = "[";
+  for (Eigen::Index i = 0; i < v.size(); ++i) s += (i ? ", " : "") + num(v[i], true);
+  return s + "]";
+}
+
+std::string json_matrix(const Eigen::MatrixXd& m) {
+  std::string s = "[";
+  for (Eigen::Index i = 0; i < m.rows(); ++i) s += (i ? ", " : "") + json_vector(m.row(i).transpose());
+  return s + "]";
+}
+
+std::string json_result(const ModelKernels& k, const FitResult& f) {
+  std::ostringstream s;
+  s << "{\"generator\": \"" << kMarker << "\", \"model\": " << json_string(k.model) << ", \"scene\": " << json_string(k.scene)
+    << ",\n \"converged\": " << (f.converged ? "true" : "false") << ", \"termination\": " << json_string(f.termination)
+    << ", \"iterations\": " << f.iterations << ", \"evaluations\": " << f.evaluations << ", \"seconds\": " << num(f.seconds, true)
+    << ",\n \"initial_cost\": " << num(f.initial_cost, true) << ", \"cost\": " << num(f.cost, true)
+    << ", \"data_cost\": " << num(f.data_cost, true) << ", \"residuals\": " << f.residuals
+    << ", \"degrees_of_freedom\": " << f.degrees_of_freedom << ", \"residual_variance\": " << num(f.residual_variance, true)
+    << ", \"weighted\": " << (f.weighted ? "true" : "false") << ",\n \"parameters\": [";
+  for (std::size_t j = 0; j < f.names.size(); ++j) {
+    const auto i = static_cast<Eigen::Index>(j);
+    s << (j ? ",\n  " : "\n  ") << "{\"name\": " << json_string(f.names[j]) << ", \"start\": " << num(f.start[i], true)
+      << ", \"estimate\": " << num(f.values[i], true) << ", \"standard_error\": " << num(f.standard_error[i], true)
+      << ", \"lower95\": " << num(f.lower95[i], true) << ", \"upper95\": " << num(f.upper95[i], true)
+      << ", \"at_bound\": " << json_string(f.at_bound[j]) << "}";
+  }
+  s << "],\n \"covariance_theta\": " << json_matrix(f.covariance) << ",\n \"correlation\": " << json_matrix(f.correlation)
+    << ",\n \"fisher\": [";
+  for (std::size_t d = 0; d < f.fisher.size(); ++d)
+    s << (d ? ",\n  " : "\n  ") << "{\"eigenvalue\": " << num(f.fisher[d].eigenvalue, true) << ", \"sigma\": "
+      << num(f.fisher[d].sigma, true) << ", \"verdict\": " << json_string(f.fisher[d].verdict)
+      << ", \"description\": " << json_string(f.fisher[d].description) << ", \"direction\": " << json_vector(f.fisher[d].direction) << "}";
+  s << "],\n \"minima\": [";
+  for (std::size_t m = 0; m < f.minima.size(); ++m)
+    s << (m ? ", " : "") << "{\"cost\": " << num(f.minima[m].cost, true) << ", \"starts\": " << f.minima[m].starts
+      << ", \"converged\": " << (f.minima[m].converged ? "true" : "false") << ", \"values\": " << json_vector(f.minima[m].values) << "}";
+  s << "],\n \"profiles\": [";
+  for (std::size_t q = 0; q < f.profiles.size(); ++q) {
+    const Profile& p = f.profiles[q];
+    s << (q ? ", " : "") << "{\"parameter\": " << json_string(p.parameter) << ", \"lower95\": " << num(p.lower, true)
+      << ", \"upper95\": " << num(p.upper, true) << ", \"points\": [";
+    for (std::size_t i = 0; i < p.points.size(); ++i)
+      s << (i ? ", " : "") << "[" << num(p.points[i].value, true) << ", " << num(p.points[i].cost, true) << "]";
+    s << "]}";
+  }
+  s << "],\n \"warnings\": [";
+  for (std::size_t w = 0; w < f.warnings.size(); ++w) s << (w ? ", " : "") << json_string(f.warnings[w]);
+  s << "]}\n";
+  return s.str();
+}
+
+// Every data point: data, the model at the start and at the fit, the weighted residuals.
+std::string points_csv(const ModelKernels& k, const FitResult& f) {
+  std::ostringstream s;
+  s << "# " << kMarker << ": model " << csv_field(k.model) << ", the data points with the model at the start and the fit\n"
+    << "source,line,set,kind,input,output,frequency_hz_or_mode,data_re,data_im,initial_re,initial_im,fitted_re,fitted_im,"
+       "residual_magnitude,residual_phase\n";
+  for (const FitResult::Point& p : f.points)
+    s << csv_field(p.source) << "," << p.line << "," << csv_field(p.set) << "," << p.kind << "," << csv_field(p.input) << ","
+      << csv_field(p.output) << "," << num(p.hz, false) << "," << num(p.data.real(), false) << "," << num(p.data.imag(), false)
+      << "," << num(p.initial.real(), false) << "," << num(p.initial.imag(), false) << "," << num(p.fitted.real(), false)
+      << "," << num(p.fitted.imag(), false) << "," << num(p.residual_magnitude, false) << ","
+      << num(p.residual_phase, false) << "\n";
+  return s.str();
+}
+
+// The plot's curves: the model at the start and at the fit on 200 frequencies over each data
+// set's range.
+std::vector<FitPlotSeries> plot_series(const GeneratedModel& model0, const FitResult& f, const MeasuredData& data) {
+  std::vector<FitPlotSeries> out;
+  GeneratedModel model = model0;
+  const auto response = [&](const Eigen::VectorXd& p, const FrfData& d, const std::vector<double>& hz) {
+    for (std::size_t j = 0; j < f.names.size(); ++j) model.set(f.names[j], p[static_cast<Eigen::Index>(j)]);
+    const auto s = frequency_response_sensitivity(model.linear_model(), {}, hz);
+    const Eigen::Index in = model.input_index(d.input), o = model.output_index(d.output);
+    std::vector<std::complex<double>> h;
+    for (const auto& m : s.response) h.push_back(m(o, in));
+    return h;
+  };
+  for (const FrfData& d : data.responses) {
+    FitPlotSeries s;
+    s.label = (d.set.empty() ? "" : d.set + ": ") + d.output + "/" + d.input;
+    const auto unit_of = [](const char* const* units, Eigen::Index i) {
+      return units && units[i] && *units[i] ? std::string(units[i]) : std::string("-");
+    };
+    const std::string unit = unit_of(model.kernels().output_units, model.output_index(d.output)) + "/" +
+                             unit_of(model.kernels().input_units, model.input_index(d.input));
+    const double lo = *std::min_element(d.hz.begin(), d.hz.end()), hi = *std::max_element(d.hz.begin(), d.hz.end());
+    for (int i = 0; i < 200; ++i) s.curve_hz.push_back(lo * std::pow(hi / lo, i / 199.0));
+    s.initial = response(f.start, d, s.curve_hz);
+    s.fitted = response(f.values, d, s.curve_hz);
+    for (const FitResult::Point& p : f.points)
+      if (p.kind == "frf" && label(p) == s.label && p.source == d.source) {
+        s.hz.push_back(p.hz);
+        s.data.push_back(p.data);
+        s.has_phase.push_back(!std::isnan(p.residual_phase));
+        s.residual_magnitude.push_back(p.residual_magnitude);
+        s.residual_phase.push_back(p.residual_phase);
+      }
+    s.label += " [" + unit + "]";
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+}  // namespace
+
+CLI::App* add_fit(CLI::App& app, FitCliOptions& o) {
+  CLI::App* fit = app.add_subcommand("fit", "fit parameters to measured frequency responses and modal data (docs/fitting.md)");
+  fit->add_option("--data", o.data, "measured data (CSV: frequency_hz with re,im or magnitude[,phase_deg]; or mode,frequency_hz,damping_ratio); repeatable")
+      ->required();
+  fit->add_option("--parameter", o.parameters, "a fitted parameter NAME=LO:HI[:xF | :+-W][:lin]; repeatable")->required();
+  fit->add_option("--input", o.input, "the input of data files without an input column");
+  fit->add_option("--output", o.output, "the output of data files without an output column");
+  fit->add_option("--set", o.set, "set a parameter, NAME=VALUE (SI units): the start and the priors' centre; repeatable");
+  fit->add_option("--starts", o.starts, "starting points: the start, then a Latin hypercube within the bounds")
+      ->check(CLI::Range(1, 100000));
+  fit->add_option("--threads", o.threads, "threads for the starts (default: every core)")->check(CLI::Range(0, 1024));
+  fit->add_option("--seed", o.seed, "seed of the starts' Latin hypercube")->check(seed_value());
+  fit->add_option("--max-iterations", o.max_iterations, "Levenberg-Marquardt steps per start")->check(CLI::Range(1, 100000));
+  fit->add_option("--profile", o.profile, "trace the profile likelihood of these parameters")->delimiter(',');
+  fit->add_option("--profile-points", o.profile_points, "points of each profile")->check(CLI::Range(3, 1001));
+  fit->add_flag("--no-fit", o.no_fit, "no optimization: the statistics and identifiability at the start");
+  fit->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json"}));
+  fit->add_option("--out", o.out_dir, "write fit.json and fit_points.csv (and fit_profile_NAME.csv) into this directory");
+  fit->add_option("--plot", o.plot, "write data, start and fit with the residuals (FILE.svg or FILE.png)");
+  return fit;
+}
+
+int run_fit(const ModelKernels& k, const FitCliOptions& o, std::ostream& out, std::ostream& err) {
+  GeneratedModel model(k);
+  for (const std::string& a : o.set) model.set(a);
+  MeasuredData data;
+  for (const std::string& file : o.data) {
+    MeasuredData d = read_measured_data_file(file, o.input, o.output);
+    for (auto& r : d.responses) data.responses.push_back(std::move(r));
+    for (auto& m : d.modal) data.modal.push_back(std::move(m));
+  }
+  std::vector<FitParameter> params;
+  for (const std::string& p : o.parameters) params.push_back(parse_fit_parameter(p));
+  std::vector<OutputFile> files;
+  if (!o.out_dir.empty()) {
+    refuse_non_directory(o.out_dir, "fit --out");
+    files.push_back({std::filesystem::path(o.out_dir) / "fit.json", ""});
+    files.push_back({std::filesystem::path(o.out_dir) / "fit_points.csv", ""});
+    for (const std::string& name : o.profile) {
+      for (char c : name)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_'))
+          throw Error("fit --profile '" + name + "': a name for a file name has only letters, digits and '_'");
+      files.push_back({std::filesystem::path(o.out_dir) / ("fit_profile_" + name + ".csv"), ""});
+    }
+    std::vector<std::filesystem::path> paths;
+    for (const auto& f : files) paths.push_back(f.path);
+    refuse_foreign_files(paths, kMarker, "fit");  // before the work, not after
+  }
+  if (!o.plot.empty()) refuse_special_file(o.plot, "fit --plot");
+  FitOptions opt;
+  opt.starts = o.starts;
+  opt.threads = o.threads;
+  opt.seed = o.seed;
+  opt.max_iterations = o.max_iterations;
+  opt.optimize = !o.no_fit;
+  opt.profile = o.profile;
+  opt.profile_points = o.profile_points;
+  const FitResult f = fit(model, data, params, opt);
+  if (o.format == "json")
+    out << json_result(k, f);
+  else
+    write_table(out, k, f);
+  if (!files.empty()) {
+    files[0].content = json_result(k, f);
+    files[1].content = points_csv(k, f);
+    for (std::size_t q = 0; q < f.profiles.size(); ++q) {
+      std::ostringstream s;
+      s << "# " << kMarker << ": model " << csv_field(k.model) << ", profile likelihood of " << f.profiles[q].parameter
+        << " (cost: 1/2 sum r^2 with the others optimized; 95 %: 2 (cost - " << num(f.cost, false) << ")/s^2 = 3.84)\n"
+        << f.profiles[q].parameter << ",cost,converged\n";
+      for (const ProfilePoint& p : f.profiles[q].points)
+        s << num(p.value, false) << "," << num(p.cost, false) << "," << (p.converged ? 1 : 0) << "\n";
+      files[2 + q].content = s.str();
+    }
+    write_all_or_nothing(files, kMarker, "fit");
+  }
+  if (!o.plot.empty() && !data.responses.empty()) {
+    FitPlot plot;
+    plot.title = "fit of '" + std::string(k.model) + "': data, start (cost " + short_num(f.initial_cost) + ") and fit (cost " +
+                 short_num(f.cost) + (f.converged ? ")" : ", NOT CONVERGED)");
+    write_fit_plot(o.plot, plot_series(model, f, data), plot);
+  }
+  if (!f.converged) {
+    err << "fit: the fit did not converge (" << f.termination << "): the values printed are where it stopped, not a minimum\n";
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace mbsgen::cli
+
+namespace mbsgen::cli {
+
+int fit_main(const std::string& tape_file, int argc, char** argv) {
+  std::unique_ptr<TapeModel> tape;
+  try {
+    tape = TapeModel::load(tape_file);
+  } catch (const Error& e) {
+    std::cerr << "mbsgen-fit: " << e.what() << "\n";
+    return 1;
+  }
+  const ModelKernels& k = tape->kernels();
+  const std::string program = std::string(k.model) + "-solve";
+  CLI::App app{"fit parameters of model '" + std::string(k.model) + "' to measured data"};
+  app.name(program);
+  app.require_subcommand(1);
+  FitCliOptions o;
+  CLI::App* fit = add_fit(app, o);
+  try {
+    std::vector<std::string> args;
+    for (int i = argc - 1; i >= 1; --i) args.emplace_back(argv[i]);
+    app.parse(args);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) {
+      std::cout << fit->help();
+      return 0;
+    }
+    std::cerr << program << ": " << e.what() << "\nRun with --help for more information.\n";
+    return 2;
+  }
+  try {
+    return run_fit(k, o, std::cout, std::cerr);
+  } catch (const NameError& e) {
+    std::cerr << program << ": fit: " << e.what() << "\n";
+    return 2;
+  } catch (const Error& e) {
+    std::cerr << program << ": fit: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << program << ": fit: error: out of memory\n";
+    return 1;
+  }
+}
+
+}  // namespace mbsgen::cli
