@@ -198,12 +198,14 @@ std::vector<LocalMinimum> distinct_minima(const detail::FitEvaluator& e, std::ve
 // How far a relative standard deviation σ (of ln p) spreads: "±0.9 %" for small ones, "a factor 2.7"
 // for large ones, "unbounded" for none.
 std::string spread_text(double sigma) {
-  if (!std::isfinite(sigma)) return "unbounded";
-  char b[64];
+  if (!std::isfinite(sigma)) return "the data do not depend on it at all";
+  char b[96];
   if (sigma < 0.1)
     std::snprintf(b, sizeof b, "one standard deviation %.2g %%", 100 * sigma);
+  else if (sigma <= 5)
+    std::snprintf(b, sizeof b, "one standard deviation a factor %.3g", std::exp(sigma));
   else
-    std::snprintf(b, sizeof b, "one standard deviation a factor %.3g", std::exp(std::min(sigma, 700.0)));
+    std::snprintf(b, sizeof b, "one standard deviation %.3g in ln p: practically unbounded", sigma);
   return b;
 }
 
@@ -399,8 +401,13 @@ void collect_warnings(const detail::FitEvaluator& e, const VectorXd& theta, FitR
       f.warnings.push_back(name + " ended on its " + f.at_bound[static_cast<std::size_t>(j)] + " bound " +
                            number_text(f.values[j]) + ": the data ask for a value beyond it; its interval is not a confidence interval");
   }
-  for (const FisherDirection& d : f.fisher)
-    if (d.verdict == "not identified") f.warnings.push_back("not identified by the data: " + d.description);
+  std::size_t unidentified = 0;
+  for (const FisherDirection& d : f.fisher) unidentified += d.verdict == "not identified";
+  if (unidentified > 0)
+    f.warnings.push_back(std::to_string(unidentified) + " of " + std::to_string(f.fisher.size()) +
+                         " directions of the parameters are not identified by the data (one standard deviation above a "
+                         "factor e; the identifiability analysis names them): their estimates rest on the start" +
+                         std::string(f.fisher.size() && unidentified ? " or the priors" : ""));
   if (f.minima.size() > 1)
     f.warnings.push_back(std::to_string(f.minima.size()) + " distinct local minima among the starts (the best reported)");
   for (const Profile& p : f.profiles)
