@@ -658,15 +658,16 @@ namespace mbsgen::cli {
 
 namespace {
 
-// The fit plot's script: data inline, one datablock of points and one of curves per series.
-std::string fit_script(const std::string& terminal, const std::vector<FitPlotSeries>& series, const FitPlot& plot) {
+// The fit plot's script: one datablock per curve ($c: hz, |start|, start phase, |fit|, fit phase,
+// phases unwrapped) and per set of points ($d: hz, |data|, phase on the fitted curve's branch,
+// residuals); data inline, labels gnuplot strings.
+std::string fit_script(const std::string& terminal, const std::vector<FitPlotCurve>& curves,
+                       const std::vector<FitPlotPoints>& points, const FitPlot& plot) {
   static const char* colours[] = {"#1f4e9c", "#c0392b", "#1e8449", "#7d3c98", "#b9770e", "#17a589"};
+  static const int marks[] = {7, 5, 9, 11, 13, 15};
   std::ostringstream s;
   s << "set terminal " << terminal << "\n";
   const auto deg = [](std::complex<double> z) { return std::arg(z) * 180.0 / kPi; };
-  double lo = 0, hi = 0;
-  // Phases unwrapped along each curve (the start's branch nearest the fit's first value), and
-  // each data point's phase on the branch nearest the fitted curve at its frequency.
   const auto unwrap = [&](const std::vector<std::complex<double>>& z, double near) {
     std::vector<double> out;
     for (std::size_t i = 0; i < z.size(); ++i) {
@@ -677,81 +678,92 @@ std::string fit_script(const std::string& terminal, const std::vector<FitPlotSer
     }
     return out;
   };
-  for (std::size_t k = 0; k < series.size(); ++k) {
-    const FitPlotSeries& x = series[k];
-    const std::vector<double> fit = unwrap(x.fitted, NAN);
-    const std::vector<double> start = unwrap(x.initial, fit.empty() ? NAN : fit.front());
-    s << "$d" << k << " << EOD\n";
-    for (std::size_t i = 0; i < x.hz.size(); ++i) {
-      double ph = x.has_phase[i] ? deg(x.data[i]) : NAN;
-      std::size_t near = 0;
-      for (std::size_t c = 0; c < x.curve_hz.size(); ++c)
-        if (std::abs(std::log(x.curve_hz[c] / x.hz[i])) < std::abs(std::log(x.curve_hz[near] / x.hz[i]))) near = c;
-      if (std::isfinite(ph) && near < fit.size()) ph += 360.0 * std::round((fit[near] - ph) / 360.0);
+  double lo = 0, hi = 0;
+  std::vector<std::vector<double>> fit_phase;
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    const FitPlotCurve& c = curves[k];
+    fit_phase.push_back(unwrap(c.fitted, NAN));
+    const std::vector<double> start = unwrap(c.initial, fit_phase.back().empty() ? NAN : fit_phase.back().front());
+    s << "$c" << k << " << EOD\n";
+    for (std::size_t i = 0; i < c.hz.size(); ++i) {
       char line[256];
-      std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g %.17g\n", x.hz[i], std::abs(x.data[i]), ph,
-                    x.residual_magnitude[i], x.residual_phase[i]);
+      std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g %.17g\n", c.hz[i], std::abs(c.initial[i]), start[i],
+                    std::abs(c.fitted[i]), fit_phase.back()[i]);
       s << line;
-    }
-    s << "EOD\n$c" << k << " << EOD\n";
-    for (std::size_t i = 0; i < x.curve_hz.size(); ++i) {
-      char line[256];
-      std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g %.17g\n", x.curve_hz[i], std::abs(x.initial[i]),
-                    start[i], std::abs(x.fitted[i]), fit[i]);
-      s << line;
-      lo = lo == 0 ? x.curve_hz[i] : std::min(lo, x.curve_hz[i]);
-      hi = std::max(hi, x.curve_hz[i]);
+      lo = lo == 0 ? c.hz[i] : std::min(lo, c.hz[i]);
+      hi = std::max(hi, c.hz[i]);
     }
     s << "EOD\n";
   }
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const FitPlotPoints& x = points[k];
+    const FitPlotCurve& c = curves[x.curve];
+    s << "$d" << k << " << EOD\n";
+    for (std::size_t i = 0; i < x.hz.size(); ++i) {
+      double ph = x.has_phase[i] ? deg(x.data[i]) : NAN;
+      std::size_t near = 0;  // the curve's frequency nearest the point's (log scale)
+      for (std::size_t j = 0; j < c.hz.size(); ++j)
+        if (std::abs(std::log(c.hz[j] / x.hz[i])) < std::abs(std::log(c.hz[near] / x.hz[i]))) near = j;
+      if (std::isfinite(ph) && near < fit_phase[x.curve].size()) ph += 360.0 * std::round((fit_phase[x.curve][near] - ph) / 360.0);
+      char line[256];
+      std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g %.17g\n", x.hz[i], x.has_magnitude[i] ? std::abs(x.data[i]) : NAN,
+                    ph, x.residual_magnitude[i], x.residual_phase[i]);
+      s << line;
+    }
+    s << "EOD\n";
+  }
+  const auto any = [&](const FitPlotPoints& x, const std::vector<bool>& v) {
+    return std::find(v.begin(), v.end(), true) != v.end() && !x.hz.empty();
+  };
   s << "set multiplot layout 3,1 title " << gnuplot_string(plot.title) << " noenhanced\n";
   if (hi > lo) s << "set xrange [" << lo / 1.1 << ":" << hi * 1.1 << "]\n";
   s << "set logscale x\nset grid xtics ytics mxtics\nset format x '10^{%L}'\nset key outside right top box noenhanced\n"
-    << "set lmargin 12\nset rmargin 44\n";
-  const auto each = [&](const std::function<std::string(std::size_t, const std::string&)>& f) {
+    << "set lmargin 12\nset rmargin 36\n";
+  const auto curve_lines = [&](int start_col, int fit_col) {
     std::string out;
-    for (std::size_t k = 0; k < series.size(); ++k) {
-      const std::string c = std::string("lc rgb '") + colours[k % 6] + "'";
-      out += (k ? ", " : "") + f(k, c);
+    for (std::size_t k = 0; k < curves.size(); ++k) {
+      const std::string c = std::string("lc rgb '") + colours[k % 6] + "'", n = std::to_string(k);
+      out += (k ? ", " : "") + std::string("$c") + n + " using 1:" + std::to_string(start_col) + " with lines dt 2 lw 1.5 " + c +
+             " title " + gnuplot_string(curves[k].label + " start") + ", $c" + n + " using 1:" + std::to_string(fit_col) +
+             " with lines lw 2 " + c + " title " + gnuplot_string(curves[k].label + " fit");
     }
     return out;
   };
-  s << "set logscale y\nset format y '10^{%L}'\nset ylabel 'magnitude |output/input| [units: legend]'\n"
-    << "plot " << each([&](std::size_t k, const std::string& c) {
-         const std::string n = series[k].label;
-         return "$d" + std::to_string(k) + " using 1:2 with points pt 7 ps 1.2 " + c + " title " + gnuplot_string(n + " data") +
-                ", $c" + std::to_string(k) + " using 1:2 with lines dt 2 lw 1.5 " + c + " title " + gnuplot_string(n + " start") +
-                ", $c" + std::to_string(k) + " using 1:4 with lines lw 2 " + c + " title " + gnuplot_string(n + " fit");
-       })
-    << "\nunset logscale y\nset format y '%g'\nset ylabel 'phase [deg]'\n"
-    << "plot " << each([&](std::size_t k, const std::string& c) {
-         const std::string n = series[k].label;
-         return "$d" + std::to_string(k) + " using 1:3 with points pt 7 ps 1.2 " + c + " title " +
-                gnuplot_string(n + " data (where measured)") + ", $c" + std::to_string(k) + " using 1:3 with lines dt 2 lw 1.5 " + c +
-                " title " + gnuplot_string(n + " start") + ", $c" + std::to_string(k) + " using 1:5 with lines lw 2 " + c +
-                " title " + gnuplot_string(n + " fit");
-       })
-    << "\nset ylabel 'weighted residual [-]'\nset xlabel 'frequency [Hz]'\n"
-    << "plot " << each([&](std::size_t k, const std::string& c) {
-         const std::string n = series[k].label;
-         return "$d" + std::to_string(k) + " using 1:4 with points pt 7 " + c + " title " + gnuplot_string(n + " ln|H| residual") +
-                ", $d" + std::to_string(k) + " using 1:5 with points pt 6 " + c + " title " + gnuplot_string(n + " phase residual");
-       })
-    << ", 2 with lines dt 3 lc rgb '#777777' title '+2 (2 sigma)', -2 with lines dt 3 lc rgb '#777777' title '-2'"
-    << ", 0 with lines lc rgb '#000000' notitle\n"
-    << "unset multiplot\n";
+  const auto point_marks = [&](int col, bool magnitude, bool open, const std::string& what) {
+    std::string out;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      if (!any(points[k], magnitude ? points[k].has_magnitude : points[k].has_phase)) continue;
+      const std::string c = std::string("lc rgb '") + colours[(k + 2) % 6] + "'";
+      out += ", $d" + std::to_string(k) + " using 1:" + std::to_string(col) + " with points pt " +
+             std::to_string(marks[k % 6] - (open ? 1 : 0)) + " ps 1.3 " + c + " title " + gnuplot_string(points[k].label + what);
+    }
+    return out;
+  };
+  s << "set logscale y\nset format y '10^{%L}'\nset ylabel 'magnitude [units: legend]'\n"
+    << "plot " << curve_lines(2, 4) << point_marks(2, true, false, " data") << "\n"
+    << "unset logscale y\nset format y '%g'\nset ylabel 'phase [deg]'\n"
+    << "plot " << curve_lines(3, 5) << point_marks(3, false, false, " data") << "\n"
+    << "set ylabel 'weighted residual [-]'\nset xlabel 'frequency [Hz]'\n"
+    << "plot 2 with lines dt 3 lc rgb '#777777' title '+2 (2 sigma)', -2 with lines dt 3 lc rgb '#777777' title '-2', "
+    << "0 with lines lc rgb '#000000' notitle" << point_marks(4, true, false, " ln|H|") << point_marks(5, false, true, " phase")
+    << "\nunset multiplot\n";
   return s.str();
 }
 
 }  // namespace
 
-void write_fit_plot(const std::string& path, const std::vector<FitPlotSeries>& series, const FitPlot& plot) {
-  if (series.empty()) throw DimensionError("write_fit_plot: no series");
-  for (const FitPlotSeries& x : series)
-    if (x.data.size() != x.hz.size() || x.has_phase.size() != x.hz.size() || x.residual_magnitude.size() != x.hz.size() ||
-        x.residual_phase.size() != x.hz.size() || x.initial.size() != x.curve_hz.size() || x.fitted.size() != x.curve_hz.size())
-      throw DimensionError("write_fit_plot: series '" + x.label + "' has vectors of different sizes");
-  render(path, [&](const std::string& terminal) { return fit_script(terminal, series, plot); }, "1100,1000");
+void write_fit_plot(const std::string& path, const std::vector<FitPlotCurve>& curves,
+                    const std::vector<FitPlotPoints>& points, const FitPlot& plot) {
+  if (curves.empty()) throw DimensionError("write_fit_plot: no curve");
+  for (const FitPlotCurve& c : curves)
+    if (c.initial.size() != c.hz.size() || c.fitted.size() != c.hz.size() || c.hz.empty())
+      throw DimensionError("write_fit_plot: curve '" + c.label + "' has vectors of different sizes");
+  for (const FitPlotPoints& x : points)
+    if (x.curve >= curves.size() || x.data.size() != x.hz.size() || x.has_phase.size() != x.hz.size() ||
+        x.has_magnitude.size() != x.hz.size() || x.residual_magnitude.size() != x.hz.size() ||
+        x.residual_phase.size() != x.hz.size())
+      throw DimensionError("write_fit_plot: the points of '" + x.label + "' do not fit their sizes or curve");
+  render(path, [&](const std::string& terminal) { return fit_script(terminal, curves, points, plot); }, "1100,1000");
 }
 
 }  // namespace mbsgen::cli

@@ -71,24 +71,30 @@ struct BandPlot {
 void write_band_plot(const std::string& path, const std::vector<double>& hz,
                      const std::vector<std::vector<double>>& bands, const BandPlot& plot);
 
-/// One measured frequency response of a fit (fit_cli.cpp): the data points, the model's curves
-/// at the start and at the fit, and the weighted residuals.
-struct FitPlotSeries {
-  std::string label;  // e.g. "v_stapes/P"
+/// A fit's model response for one input/output pair (fit_cli.cpp): at the start and at the fit.
+struct FitPlotCurve {
+  std::string label;  // e.g. "v_stapes/P [m/s/Pa]"
   std::vector<double> hz;
-  std::vector<std::complex<double>> data;  // magnitude only where !has_phase
-  std::vector<bool> has_phase;
+  std::vector<std::complex<double>> initial, fitted;
+};
+/// One data set's points on a curve: data, and the weighted residuals at the fit.
+struct FitPlotPoints {
+  std::string label;  // e.g. "goode"
+  std::size_t curve = 0;
+  std::vector<double> hz;
+  std::vector<std::complex<double>> data;
+  std::vector<bool> has_magnitude, has_phase;
   std::vector<double> residual_magnitude, residual_phase;  // NaN: none
-  std::vector<double> curve_hz;
-  std::vector<std::complex<double>> initial, fitted;  // at curve_hz
 };
 struct FitPlot {
   std::string title;
 };
 
 /// Writes a fit's plot to `path`, as write_bode_plot does: magnitude (log–log) and phase of the
-/// data (points), the start (dashed) and the fit (solid) per series, and below the weighted
-/// residuals of magnitude and phase against frequency with the band ±2 named.
-void write_fit_plot(const std::string& path, const std::vector<FitPlotSeries>& series, const FitPlot& plot);
+/// data (points, one colour and mark per set), the start (dashed) and the fit (solid) per curve,
+/// and below the weighted residuals of magnitude (filled) and phase (open) against frequency
+/// with the lines ±2 named.
+void write_fit_plot(const std::string& path, const std::vector<FitPlotCurve>& curves,
+                    const std::vector<FitPlotPoints>& points, const FitPlot& plot);
 
 }  // namespace mbsgen::cli

@@ -26,10 +26,6 @@ namespace {
 constexpr const char* kMarker = "mbsgen fit";
 constexpr double kPi = 3.14159265358979323846;
 
-std::string label(const FitResult::Point& p) {
-  return (p.set.empty() ? "" : p.set + ": ") + p.output + "/" + p.input;
-}
-
 void write_table(std::ostream& out, const ModelKernels& k, const FitResult& f) {
   out << "# fit of model '" << k.model << "' (scene '" << k.scene << "'): " << f.residuals << " residuals, "
       << f.names.size() << " parameters, " << (f.converged ? "converged" : "NOT CONVERGED") << " (" << f.termination
@@ -126,43 +122,59 @@ std::string points_csv(const ModelKernels& k, const FitResult& f) {
   return s.str();
 }
 
-// The plot's curves: the model at the start and at the fit on 200 frequencies over each data
-// set's range.
-std::vector<FitPlotSeries> plot_series(const GeneratedModel& model0, const FitResult& f, const MeasuredData& data) {
-  std::vector<FitPlotSeries> out;
+// The plot: per input/output pair the model at the start and at the fit on 200 frequencies over
+// its data's range, and per data set its points with their residuals.
+void plot_fit(const std::string& path, const GeneratedModel& model0, const FitResult& f, const MeasuredData& data,
+              const FitPlot& plot) {
   GeneratedModel model = model0;
-  const auto response = [&](const Eigen::VectorXd& p, const FrfData& d, const std::vector<double>& hz) {
-    for (std::size_t j = 0; j < f.names.size(); ++j) model.set(f.names[j], p[static_cast<Eigen::Index>(j)]);
-    const auto s = frequency_response_sensitivity(model.linear_model(), {}, hz);
-    const Eigen::Index in = model.input_index(d.input), o = model.output_index(d.output);
-    std::vector<std::complex<double>> h;
-    for (const auto& m : s.response) h.push_back(m(o, in));
-    return h;
+  std::vector<FitPlotCurve> curves;
+  std::vector<FitPlotPoints> points;
+  std::vector<std::pair<std::string, std::string>> io;
+  const auto unit_of = [](const char* const* units, Eigen::Index i) {
+    return units && units[i] && *units[i] ? std::string(units[i]) : std::string("-");
   };
   for (const FrfData& d : data.responses) {
-    FitPlotSeries s;
-    s.label = (d.set.empty() ? "" : d.set + ": ") + d.output + "/" + d.input;
-    const auto unit_of = [](const char* const* units, Eigen::Index i) {
-      return units && units[i] && *units[i] ? std::string(units[i]) : std::string("-");
-    };
-    const std::string unit = unit_of(model.kernels().output_units, model.output_index(d.output)) + "/" +
-                             unit_of(model.kernels().input_units, model.input_index(d.input));
+    const std::pair<std::string, std::string> key{d.input, d.output};
+    auto it = std::find(io.begin(), io.end(), key);
     const double lo = *std::min_element(d.hz.begin(), d.hz.end()), hi = *std::max_element(d.hz.begin(), d.hz.end());
-    for (int i = 0; i < 200; ++i) s.curve_hz.push_back(lo * std::pow(hi / lo, i / 199.0));
-    s.initial = response(f.start, d, s.curve_hz);
-    s.fitted = response(f.values, d, s.curve_hz);
+    if (it == io.end()) {
+      io.push_back(key);
+      it = io.end() - 1;
+      const Eigen::Index in = model.input_index(d.input), out = model.output_index(d.output);
+      curves.push_back({d.output + "/" + d.input + " [" + unit_of(model.kernels().output_units, out) + "/" +
+                            unit_of(model.kernels().input_units, in) + "]",
+                        {lo, hi}, {}, {}});
+    }
+    FitPlotCurve& c = curves[static_cast<std::size_t>(it - io.begin())];
+    c.hz = {std::min(c.hz.front(), lo), std::max(c.hz.back(), hi)};
+    FitPlotPoints x;
+    x.label = d.set.empty() ? d.output + "/" + d.input : d.set;
+    x.curve = static_cast<std::size_t>(it - io.begin());
     for (const FitResult::Point& p : f.points)
-      if (p.kind == "frf" && label(p) == s.label && p.source == d.source) {
-        s.hz.push_back(p.hz);
-        s.data.push_back(p.data);
-        s.has_phase.push_back(!std::isnan(p.residual_phase));
-        s.residual_magnitude.push_back(p.residual_magnitude);
-        s.residual_phase.push_back(p.residual_phase);
+      if (p.kind == "frf" && p.set == d.set && p.input == d.input && p.output == d.output && p.source == d.source) {
+        x.hz.push_back(p.hz);
+        x.data.push_back(p.data);
+        x.has_magnitude.push_back(!std::isnan(p.residual_magnitude));
+        x.has_phase.push_back(!std::isnan(p.residual_phase));
+        x.residual_magnitude.push_back(p.residual_magnitude);
+        x.residual_phase.push_back(p.residual_phase);
       }
-    s.label += " [" + unit + "]";
-    out.push_back(std::move(s));
+    points.push_back(std::move(x));
   }
-  return out;
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    FitPlotCurve& c = curves[k];
+    const double lo = c.hz.front(), hi = c.hz.back();
+    c.hz.clear();
+    for (int i = 0; i < 200; ++i) c.hz.push_back(hi > lo ? lo * std::pow(hi / lo, i / 199.0) : lo);
+    for (int at = 0; at < 2; ++at) {
+      const Eigen::VectorXd& p = at == 0 ? f.start : f.values;
+      for (std::size_t j = 0; j < f.names.size(); ++j) model.set(f.names[j], p[static_cast<Eigen::Index>(j)]);
+      const auto s = frequency_response_sensitivity(model.linear_model(), {}, c.hz);
+      const Eigen::Index in = model.input_index(io[k].first), out = model.output_index(io[k].second);
+      for (const auto& m : s.response) (at == 0 ? c.initial : c.fitted).push_back(m(out, in));
+    }
+  }
+  write_fit_plot(path, curves, points, plot);
 }
 
 }  // namespace
@@ -247,7 +259,7 @@ int run_fit(const ModelKernels& k, const FitCliOptions& o, std::ostream& out, st
     FitPlot plot;
     plot.title = "fit of '" + std::string(k.model) + "': data, start (cost " + short_num(f.initial_cost) + ") and fit (cost " +
                  short_num(f.cost) + (f.converged ? ")" : ", NOT CONVERGED)");
-    write_fit_plot(o.plot, plot_series(model, f, data), plot);
+    plot_fit(o.plot, model, f, data, plot);
   }
   if (!f.converged) {
     err << "fit: the fit did not converge (" << f.termination << "): the values printed are where it stopped, not a minimum\n";

@@ -4,6 +4,7 @@
 #include "mbsgen/runtime/fit/fit.hpp"
 
 #include <ceres/ceres.h>
+#include <glog/logging.h>
 
 #include <boost/math/distributions/students_t.hpp>
 
@@ -78,6 +79,21 @@ struct Solution {
   std::string termination;
   int iterations = 0, evaluations = 0;
 };
+
+// Ceres reports through glog, whose default writes errors to standard error ("Terminating:
+// Residual and Jacobian evaluation failed" for a start where the model cannot be evaluated): the
+// fit reports those itself. Once per process, and only if the host program has not set glog up.
+void quiet_glog() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    if (!google::IsGoogleLoggingInitialized()) {
+      FLAGS_minloglevel = google::GLOG_FATAL;
+      FLAGS_logtostderr = false;
+      FLAGS_stderrthreshold = google::GLOG_FATAL;
+      google::InitGoogleLogging("mbsgen-fit");
+    }
+  });
+}
 
 // One Levenberg–Marquardt solve from theta0 within the bounds; `fixed` ≥ 0 holds that
 // coordinate (a profile). Throws FitStopped when options.stop asks.
@@ -424,6 +440,7 @@ void collect_warnings(const detail::FitEvaluator& e, const VectorXd& theta, FitR
 FitResult fit(const GeneratedModel& model, const MeasuredData& data, const std::vector<FitParameter>& parameters,
               const FitOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
+  quiet_glog();
   detail::FitEvaluator e(model, data, parameters);
   FitResult f;
   f.names = e.names();

@@ -181,7 +181,7 @@ MeasuredData read_measured_data(const std::string& text, const std::string& orig
     const double hz = r.positive(fc, "frequency_hz");
     if (std::isnan(hz)) r.fail(fc.col, "no frequency");
     std::complex<double> h;
-    bool has_phase = true;
+    bool has_phase = true, has_magnitude = true;
     if (cols.count("re")) {
       const double re = r.number(cell(cells, cols, "re"), "re"), im = r.number(cell(cells, cols, "im"), "im");
       if (std::isnan(re) || std::isnan(im)) r.fail(1, "re or im is empty");
@@ -191,19 +191,22 @@ MeasuredData read_measured_data(const std::string& text, const std::string& orig
       const bool db = cols.count("magnitude_db") > 0;
       const Cell& mc = cell(cells, cols, db ? "magnitude_db" : "magnitude");
       double mag = db ? r.number(mc, "magnitude_db") : r.positive(mc, "magnitude");
-      if (std::isnan(mag)) r.fail(mc.col, "no magnitude");
-      if (db) mag = std::pow(10.0, mag / 20.0);
       const double ph = r.number(cell(cells, cols, "phase_deg"), "phase_deg");
       has_phase = !std::isnan(ph);
+      has_magnitude = !std::isnan(mag);
+      if (!has_magnitude && !has_phase) r.fail(mc.col, "neither a magnitude nor a phase");
+      if (!has_magnitude) mag = 1.0;
+      if (db && has_magnitude) mag = std::pow(10.0, mag / 20.0);
       h = std::polar(mag, has_phase ? ph * kPi / 180.0 : 0.0);
     }
     const std::string key = set + '\n' + input + '\n' + output;
     const auto [it, added] = frf_index.emplace(key, data.responses.size());
-    if (added) data.responses.push_back(FrfData{origin, set, input, output, {}, {}, {}, {}, {}, {}});
+    if (added) data.responses.push_back(FrfData{origin, set, input, output, {}, {}, {}, {}, {}, {}, {}});
     FrfData& d = data.responses[it->second];
     d.hz.push_back(hz);
     d.value.push_back(h);
     d.has_phase.push_back(has_phase);
+    d.has_magnitude.push_back(has_magnitude);
     d.sigma_ln_magnitude.push_back(r.positive(cell(cells, cols, "sigma_magnitude"), "sigma_magnitude"));
     const double sp = r.positive(cell(cells, cols, "sigma_phase_deg"), "sigma_phase_deg");
     d.sigma_phase_rad.push_back(std::isnan(sp) ? sp : sp * kPi / 180.0);

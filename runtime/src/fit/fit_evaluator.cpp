@@ -20,6 +20,9 @@ std::string number_text(double x) {
   return b;
 }
 
+// Whether point i of d has a magnitude (data without the column has_magnitude: every point).
+bool magnitude(const FrfData& d, std::size_t i) { return d.has_magnitude.size() <= i || d.has_magnitude[i]; }
+
 // The oscillatory modes (Im λ > 0) by natural frequency: what mode k of the data means.
 std::vector<std::size_t> oscillatory(const std::vector<Mode>& modes) {
   std::vector<std::size_t> k;
@@ -81,8 +84,9 @@ FitEvaluator::FitEvaluator(const GeneratedModel& model, const MeasuredData& data
     io_.push_back(io);
     hz_.insert(hz_.end(), d.hz.begin(), d.hz.end());
     for (std::size_t i = 0; i < d.hz.size(); ++i) {
-      data_rows_ += d.has_phase[i] ? 2 : 1;
-      weighted_ = weighted_ && !std::isnan(d.sigma_ln_magnitude[i]) && (!d.has_phase[i] || !std::isnan(d.sigma_phase_rad[i]));
+      data_rows_ += (magnitude(d, i) ? 1 : 0) + (d.has_phase[i] ? 1 : 0);
+      weighted_ = weighted_ && (!magnitude(d, i) || !std::isnan(d.sigma_ln_magnitude[i])) &&
+                  (!d.has_phase[i] || !std::isnan(d.sigma_phase_rad[i]));
     }
   }
   std::sort(hz_.begin(), hz_.end());
@@ -194,10 +198,12 @@ bool FitEvaluator::evaluate(const Eigen::VectorXd& theta, Eigen::VectorXd& r, Ei
     const FrfData& d = data_.responses[k];
     for (std::size_t i = 0; i < d.hz.size(); ++i, ++point) {
       const std::complex<double> lr = std::log(h.frf[k][i] / d.value[i]);  // imag part: the wrapped phase difference
-      const double sm = std::isnan(d.sigma_ln_magnitude[i]) ? 1.0 : d.sigma_ln_magnitude[i];
-      r[row] = lr.real() / sm;
-      if (J) J->row(row) = dre.row(point) / sm;
-      ++row;
+      if (magnitude(d, i)) {
+        const double sm = std::isnan(d.sigma_ln_magnitude[i]) ? 1.0 : d.sigma_ln_magnitude[i];
+        r[row] = lr.real() / sm;
+        if (J) J->row(row) = dre.row(point) / sm;
+        ++row;
+      }
       if (!d.has_phase[i]) continue;
       const double sp = std::isnan(d.sigma_phase_rad[i]) ? 1.0 : d.sigma_phase_rad[i];
       r[row] = lr.imag() / sp;
@@ -256,7 +262,8 @@ std::vector<FitResult::Point> FitEvaluator::points(const Eigen::VectorXd& theta0
       p.initial = h0.frf[k][i];
       p.fitted = h1.frf[k][i];
       const std::complex<double> lr = std::log(p.fitted / p.data);
-      p.residual_magnitude = lr.real() / (std::isnan(d.sigma_ln_magnitude[i]) ? 1.0 : d.sigma_ln_magnitude[i]);
+      p.residual_magnitude =
+          magnitude(d, i) ? lr.real() / (std::isnan(d.sigma_ln_magnitude[i]) ? 1.0 : d.sigma_ln_magnitude[i]) : kNaN;
       p.residual_phase = d.has_phase[i] ? lr.imag() / (std::isnan(d.sigma_phase_rad[i]) ? 1.0 : d.sigma_phase_rad[i]) : kNaN;
       if (!d.has_phase[i]) {  // magnitude data: the model's phase is shown, the data's is not known
         p.data = std::abs(p.data);

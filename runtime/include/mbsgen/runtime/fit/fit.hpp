@@ -55,6 +55,7 @@ struct FrfData {
   std::vector<double> hz;
   std::vector<std::complex<double>> value;  ///< H_d (magnitude only: real, positive; has_phase false)
   std::vector<bool> has_phase;
+  std::vector<bool> has_magnitude;          ///< false: a phase alone (|value| = 1)
   std::vector<double> sigma_ln_magnitude;   ///< > 0, or NaN: no standard deviation given
   std::vector<double> sigma_phase_rad;      ///< > 0, or NaN
   std::vector<int> line;                    ///< the file's line of each point
@@ -73,7 +74,7 @@ struct ModalData {
 
 /// Reads measured data from CSV text (comments start with '#'; a header row names the columns).
 /// Frequency responses: `frequency_hz` and either `re`,`im` or `magnitude` (or `magnitude_db`)
-/// with optional `phase_deg`; optional `sigma_magnitude` (relative: σ of ln|H|),
+/// with optional `phase_deg` (a row with a phase and an empty magnitude gives the phase alone); optional `sigma_magnitude` (relative: σ of ln|H|),
 /// `sigma_phase_deg`, `input`, `output`, `set`. Modal data: `mode` and `frequency_hz` and/or
 /// `damping_ratio`, optional `sigma_frequency` (relative), `sigma_damping`, `set`. Empty cells
 /// are "not given". Defaults for a file without input/output columns: default_input and
