@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
+import warnings
 from typing import Dict, List, NamedTuple, Optional, Sequence
 
 import numpy as np
@@ -22,7 +23,8 @@ import numpy as np
 from . import _mbsgen
 from ._mbsgen import Error
 
-__all__ = ["Model", "Parameter", "Modes", "Response", "BatchResponse", "Error", "ModelError", "linear", "tool"]
+__all__ = ["Model", "Parameter", "Modes", "Response", "BatchResponse", "Error", "ModelError", "linear", "tool",
+           "FitResult", "FitEstimate", "FisherDirection", "FitWarning"]
 __version__ = _mbsgen.__version__
 
 
@@ -374,6 +376,131 @@ class Model:
     def output_values(self, **params: float) -> np.ndarray:
         """The outputs at the operating point."""
         return self._kernels.outputs(self._values(params))
+
+    def fit(self, data, parameters, *, input: Optional[str] = None, output: Optional[str] = None, starts: int = 1,
+            threads: int = 0, seed: int = 1, max_iterations: int = 200, profile: Sequence[str] = (),
+            profile_points: int = 21, optimize: bool = True, **params: float) -> "FitResult":
+        """Fits parameters to measured frequency responses and modal data (docs/fitting.md), from
+        the defaults (or the values given by keyword), with the exact Jacobian and Ceres Solver.
+
+        data: a CSV file (the columns of `fit --data`), or a dict {"frequency_hz": array,
+        "response": complex array, "sigma_magnitude": σ of ln|H| (scalar or array),
+        "sigma_phase_deg": σ of the phase, "input": name, "output": name, "set": label}, or a list
+        of them. parameters: {name: (lo, hi)} or {name: (lo, hi, prior)} with prior a factor F > 1
+        (log-normal about the start, one σ a factor F) or a string "xF", "+-W", "lin", or a list of
+        "NAME=LO:HI[:PRIOR][:lin]" strings. Returns a FitResult; a fit that did not converge is
+        returned with converged False and a FitWarning."""
+        if not _mbsgen.has_fit:
+            raise Error("fit: this build of mbsgen has no fit (built with MBSGEN_WITH_FIT=OFF, or without Ceres Solver)")
+        q = _mbsgen.FitRequest()
+        q.input, q.output = input or "", output or ""
+        arrays = []
+        for k, d in enumerate(data if isinstance(data, (list, tuple)) else [data]):
+            if isinstance(d, (str, os.PathLike)):
+                q.files = list(q.files) + [os.fspath(d)]
+            elif isinstance(d, dict):
+                arrays.append(_fit_arrays(d, k))
+            else:
+                raise ValueError(f"data[{k}]: a CSV file or a dict of arrays, not {type(d).__name__}")
+        q.arrays = arrays
+        q.parameters = _fit_parameters(parameters)
+        q.starts, q.threads, q.seed, q.max_iterations = int(starts), int(threads), int(seed), int(max_iterations)
+        q.profile, q.profile_points, q.optimize = list(profile), int(profile_points), bool(optimize)
+        r = FitResult(_mbsgen.fit(self._kernels, self._values(params), q))
+        if not r.converged:
+            warnings.warn(FitWarning(f"the fit did not converge ({r.termination}): the values are where it stopped"),
+                          stacklevel=2)
+        return r
+
+
+class FitWarning(UserWarning):
+    """A fit that did not converge, or whose result needs a caveat (FitResult.warnings)."""
+
+
+class FitEstimate(NamedTuple):
+    name: str
+    start: float
+    value: float
+    standard_error: float
+    lower95: float
+    upper95: float
+    at_bound: str  # "", "lower" or "upper"
+
+
+class FisherDirection(NamedTuple):
+    eigenvalue: float
+    sigma: float         # relative standard deviation along the direction (of ln p)
+    verdict: str         # "identified", "weakly identified", "not identified"
+    description: str     # e.g. "k_a and k_b are identified only as their ratio k_a/k_b"
+    direction: np.ndarray
+
+
+class FitResult:
+    """What Model.fit found: estimates (FitEstimate per parameter), values, covariance (of ln p
+    in log space, p in linear space), correlation, cost (½Σr² with priors), converged, fisher
+    (FisherDirection, weakest first), minima (costs, values), profiles ({name: (values, costs,
+    lower95, upper95)}), points (per data point: set, kind, hz, data, initial, fitted, weighted
+    residuals) and warnings."""
+
+    def __init__(self, o):
+        self.names = list(o.names)
+        self.values = np.array(o.values)
+        self.estimates = [FitEstimate(n, s, v, e, lo, hi, b) for n, s, v, e, lo, hi, b in
+                          zip(o.names, o.start, o.values, o.standard_error, o.lower95, o.upper95, o.at_bound)]
+        self.covariance, self.correlation = np.array(o.covariance), np.array(o.correlation)
+        self.initial_cost, self.cost, self.data_cost = o.initial_cost, o.cost, o.data_cost
+        self.residuals, self.degrees_of_freedom, self.residual_variance = o.residuals, o.degrees_of_freedom, o.residual_variance
+        self.weighted, self.converged, self.termination = o.weighted, o.converged, o.termination
+        self.iterations, self.evaluations, self.seconds = o.iterations, o.evaluations, o.seconds
+        self.fisher = [FisherDirection(e, s, v, d, o.fisher_directions[:, k]) for k, (e, s, v, d) in
+                       enumerate(zip(o.fisher_eigenvalues, o.fisher_sigma, o.fisher_verdicts, o.fisher_descriptions))]
+        self.minima = (np.array(o.minima_costs), np.array(o.minima_values))
+        self.profiles = {n: (o.profile_values[k], o.profile_costs[k], o.profile_lower[k], o.profile_upper[k])
+                         for k, n in enumerate(o.profile_names)}
+        self.points = {"set": list(o.point_sets), "kind": list(o.point_kinds), "input": list(o.point_inputs),
+                       "output": list(o.point_outputs), "hz": np.array(o.point_hz), "data": np.array(o.point_data),
+                       "initial": np.array(o.point_initial), "fitted": np.array(o.point_fitted),
+                       "residual_magnitude": np.array(o.residual_magnitude), "residual_phase": np.array(o.residual_phase)}
+        self.warnings = list(o.warnings)
+
+    def __repr__(self) -> str:
+        rows = "\n".join(f"  {e.name}: {e.value:.6g} (95 % {e.lower95:.4g} to {e.upper95:.4g})" for e in self.estimates)
+        return (f"<mbsgen.FitResult {'converged' if self.converged else 'NOT CONVERGED'}, cost {self.cost:.6g}, "
+                f"{self.residuals} residuals:\n{rows}>")
+
+
+def _fit_arrays(d: dict, k: int):
+    unknown = set(d) - {"frequency_hz", "response", "sigma_magnitude", "sigma_phase_deg", "input", "output", "set"}
+    if unknown:
+        raise ValueError(f"data[{k}]: unknown keys {sorted(unknown)}")
+    if "frequency_hz" not in d or "response" not in d:
+        raise ValueError(f"data[{k}]: needs 'frequency_hz' and 'response'")
+    a = _mbsgen.FitArrays()
+    hz = np.ascontiguousarray(d["frequency_hz"], dtype=np.float64).reshape(-1)
+    h = np.ascontiguousarray(d["response"], dtype=np.complex128).reshape(-1)
+    if h.shape != hz.shape:
+        raise ValueError(f"data[{k}]: {hz.size} frequencies but {h.size} responses")
+    full = lambda v, scale: np.broadcast_to(np.asarray(np.nan if v is None else v, dtype=np.float64) * scale, hz.shape).copy()
+    a.hz, a.values = hz, h
+    a.sigma_magnitude = full(d.get("sigma_magnitude"), 1.0)
+    a.sigma_phase_rad = full(d.get("sigma_phase_deg"), np.pi / 180)
+    a.input, a.output, a.set = str(d.get("input", "")), str(d.get("output", "")), str(d.get("set", ""))
+    return a
+
+
+def _fit_parameters(parameters) -> List[str]:
+    if isinstance(parameters, dict):
+        specs = []
+        for name, v in parameters.items():
+            v = tuple(v)
+            if len(v) not in (2, 3):
+                raise ValueError(f"parameters[{name!r}]: (lo, hi) or (lo, hi, prior), not {v!r}")
+            text = f"{name}={float(v[0])!r}:{float(v[1])!r}"
+            if len(v) == 3:
+                text += ":" + (v[2] if isinstance(v[2], str) else f"x{float(v[2])!r}")
+            specs.append(text)
+        return specs
+    return [str(p) for p in parameters]
 
 
 class linear:  # noqa: N801 (a namespace: mbsgen.linear.modes, mbsgen.linear.frf)

@@ -1,5 +1,5 @@
 # Type hints of the mbsgen package (docs/python.md).
-from typing import Any, Dict, List, NamedTuple, Optional, Sequence
+from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -102,6 +102,51 @@ class Model:
                         parameters: Optional[Sequence[str]] = None, **params: float): ...
     def parameter_sets(self, params, **values: float) -> np.ndarray: ...
     def output_values(self, **params: float) -> np.ndarray: ...
+    def fit(self, data: Any, parameters: Any, *, input: Optional[str] = ..., output: Optional[str] = ...,
+            starts: int = ..., threads: int = ..., seed: int = ..., max_iterations: int = ...,
+            profile: Sequence[str] = ..., profile_points: int = ..., optimize: bool = ..., **params: float) -> FitResult: ...
+
+class FitWarning(UserWarning): ...
+
+class FitEstimate(NamedTuple):
+    name: str
+    start: float
+    value: float
+    standard_error: float
+    lower95: float
+    upper95: float
+    at_bound: str
+
+class FisherDirection(NamedTuple):
+    eigenvalue: float
+    sigma: float
+    verdict: str
+    description: str
+    direction: np.ndarray
+
+class FitResult:
+    names: List[str]
+    values: np.ndarray
+    estimates: List[FitEstimate]
+    covariance: np.ndarray
+    correlation: np.ndarray
+    initial_cost: float
+    cost: float
+    data_cost: float
+    residuals: int
+    degrees_of_freedom: int
+    residual_variance: float
+    weighted: bool
+    converged: bool
+    termination: str
+    iterations: int
+    evaluations: int
+    seconds: float
+    fisher: List[FisherDirection]
+    minima: Tuple[np.ndarray, np.ndarray]
+    profiles: Dict[str, Tuple[np.ndarray, np.ndarray, float, float]]
+    points: Dict[str, Any]
+    warnings: List[str]
 
 class linear:
     @staticmethod

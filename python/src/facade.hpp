@@ -233,6 +233,8 @@ class Model {
   Matrix mass_matrix(const ConstVectorRef& p, const ConstVectorRef& y) const;
   Vector accelerations(const ConstVectorRef& p, const ConstVectorRef& y, const ConstVectorRef& yd,
                        const ConstVectorRef& u) const;
+  /// The kernels (for the fit's facade, fit_facade.hpp).
+  const ModelKernels& kernels() const { return *kernels_; }
 
  private:
   std::shared_ptr<void> library_;  // the compiled kernels' dlopen handle (declared first: closed last)

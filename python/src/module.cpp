@@ -9,6 +9,9 @@
 #include <chrono>
 
 #include "facade.hpp"
+#ifdef MBSGEN_PYTHON_FIT
+#include "fit_facade.hpp"
+#endif
 #include "mbsgen/runtime/error.hpp"
 #include "mbsgen/runtime/model/generated_model.hpp"
 #include "mbsgen/runtime/version.hpp"
@@ -237,6 +240,65 @@ void bind_model(py::module_& m) {
   // all), so that the Python overhead per call is a difference measured in one process.
 }
 
+#ifdef MBSGEN_PYTHON_FIT
+// fit (issue 42): its request and result, and Model.fit with Ctrl-C.
+void bind_fit(py::module_& m) {
+  py::class_<FitArrays>(m, "FitArrays")
+      .def(py::init<>())
+      .def_readwrite("input", &FitArrays::input)
+      .def_readwrite("output", &FitArrays::output)
+      .def_readwrite("set", &FitArrays::set)
+      .def_readwrite("hz", &FitArrays::hz)
+      .def_readwrite("values", &FitArrays::values)
+      .def_readwrite("sigma_magnitude", &FitArrays::sigma_magnitude)
+      .def_readwrite("sigma_phase_rad", &FitArrays::sigma_phase_rad);
+  py::class_<FitRequest>(m, "FitRequest")
+      .def(py::init<>())
+      .def_readwrite("files", &FitRequest::files)
+      .def_readwrite("input", &FitRequest::input)
+      .def_readwrite("output", &FitRequest::output)
+      .def_readwrite("arrays", &FitRequest::arrays)
+      .def_readwrite("parameters", &FitRequest::parameters)
+      .def_readwrite("starts", &FitRequest::starts)
+      .def_readwrite("threads", &FitRequest::threads)
+      .def_readwrite("max_iterations", &FitRequest::max_iterations)
+      .def_readwrite("profile_points", &FitRequest::profile_points)
+      .def_readwrite("seed", &FitRequest::seed)
+      .def_readwrite("optimize", &FitRequest::optimize)
+      .def_readwrite("profile", &FitRequest::profile);
+  py::class_<FitOutcome> f(m, "FitOutcome");
+#define MBSGEN_FIELD(name) f.def_readonly(#name, &FitOutcome::name)
+  MBSGEN_FIELD(names); MBSGEN_FIELD(at_bound); MBSGEN_FIELD(warnings); MBSGEN_FIELD(start); MBSGEN_FIELD(values);
+  MBSGEN_FIELD(standard_error); MBSGEN_FIELD(lower95); MBSGEN_FIELD(upper95); MBSGEN_FIELD(covariance);
+  MBSGEN_FIELD(correlation); MBSGEN_FIELD(initial_cost); MBSGEN_FIELD(cost); MBSGEN_FIELD(data_cost);
+  MBSGEN_FIELD(residual_variance); MBSGEN_FIELD(seconds); MBSGEN_FIELD(residuals); MBSGEN_FIELD(degrees_of_freedom);
+  MBSGEN_FIELD(iterations); MBSGEN_FIELD(evaluations); MBSGEN_FIELD(weighted); MBSGEN_FIELD(converged);
+  MBSGEN_FIELD(termination); MBSGEN_FIELD(fisher_eigenvalues); MBSGEN_FIELD(fisher_sigma); MBSGEN_FIELD(fisher_directions);
+  MBSGEN_FIELD(fisher_verdicts); MBSGEN_FIELD(fisher_descriptions); MBSGEN_FIELD(minima_costs); MBSGEN_FIELD(minima_values);
+  MBSGEN_FIELD(profile_names); MBSGEN_FIELD(profile_values); MBSGEN_FIELD(profile_costs); MBSGEN_FIELD(profile_lower);
+  MBSGEN_FIELD(profile_upper); MBSGEN_FIELD(point_sets); MBSGEN_FIELD(point_kinds); MBSGEN_FIELD(point_inputs);
+  MBSGEN_FIELD(point_outputs); MBSGEN_FIELD(point_hz); MBSGEN_FIELD(residual_magnitude); MBSGEN_FIELD(residual_phase);
+  MBSGEN_FIELD(point_data); MBSGEN_FIELD(point_initial); MBSGEN_FIELD(point_fitted);
+#undef MBSGEN_FIELD
+  m.def(
+      "fit",
+      [](const Model& model, const ConstVectorRef& p, const FitRequest& request) {
+        const auto interrupted = [] {
+          py::gil_scoped_acquire gil;
+          return PyErr_CheckSignals() != 0;
+        };
+        try {
+          return fit(model, p, request, interrupted);
+        } catch (const Stopped&) {
+          py::gil_scoped_acquire gil;
+          throw py::error_already_set();
+        }
+      },
+      py::arg("model"), py::arg("p"), py::arg("request"), py::call_guard<py::gil_scoped_release>());
+  m.attr("has_fit") = true;
+}
+#endif
+
 // The analyses of matrices, and the facade's calls timed in C++.
 void bind_functions(py::module_& m) {
   auto timing = m.def_submodule("_timing", "the facade's calls timed in C++ (bench/python_bench.py)");
@@ -288,4 +350,9 @@ PYBIND11_MODULE(_mbsgen, m) {
   bind_analyses(m);
   bind_model(m);
   bind_functions(m);
+#ifdef MBSGEN_PYTHON_FIT
+  bind_fit(m);
+#else
+  m.attr("has_fit") = false;
+#endif
 }

@@ -471,3 +471,66 @@ def test_simulate_at_given_times():
     assert np.allclose(r.t, t, rtol=0, atol=1e-12)
     with pytest.raises(ValueError, match="evenly spaced"):
         m.simulate(np.array([0.0, 0.1, 0.3]))
+
+
+# ---------------------------------------------------------------------------------------------
+# fit (issue 42): the same fit as the command line's, bit for bit; arrays as data; FitWarning.
+
+CHAIN = "models/textbook/chain3_sympy.yaml"
+
+
+def chain_data(tmp_path, noise=0.01):
+    """The chain's response F -> end_x with k = 12, 18, 33 and 1 % noise, as a data file."""
+    m = model(CHAIN, "full")
+    hz = np.logspace(np.log10(0.2), 1.0, 40)
+    h = m.frf("F", "end_x", hz, k1=12, k2=18, k3=33).values
+    rng = np.random.default_rng(4)
+    h = h * np.exp(noise * rng.standard_normal(hz.size) + 1j * noise * rng.standard_normal(hz.size))
+    path = tmp_path / "chain.csv"
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("frequency_hz,re,im,sigma_magnitude,sigma_phase_deg\n")
+        for a, b in zip(hz, h):
+            f.write(f"{a!r},{b.real!r},{b.imag!r},{noise!r},{np.degrees(noise)!r}\n")
+    return path, hz, h
+
+
+@pytest.mark.skipif(not mbsgen._mbsgen.has_fit, reason="built without fit (Ceres Solver)")
+def test_fit_equals_the_command_line(tmp_path):
+    path, hz, h = chain_data(tmp_path)
+    params = {"k1": (1, 100), "k2": (1, 100), "k3": (1, 100, 2.0)}
+    r = model(CHAIN, "full").fit(str(path), params, input="F", output="end_x")
+    c = cli(CHAIN, "full", "fit", "--data", str(path), "--input", "F", "--output", "end_x", "--format", "json",
+            "--parameter", "k1=1:100", "--parameter", "k2=1:100", "--parameter", "k3=1:100:x2")
+    assert r.converged and c["converged"]
+    assert [p["estimate"] for p in c["parameters"]] == list(r.values)
+    assert [p["upper95"] for p in c["parameters"]] == [e.upper95 for e in r.estimates]
+    assert c["cost"] == r.cost
+    # The same data as arrays: the same fit (the file's numbers are the arrays' to the last bit).
+    a = model(CHAIN, "full").fit({"frequency_hz": hz, "response": h, "sigma_magnitude": 0.01,
+                                  "sigma_phase_deg": np.degrees(0.01), "input": "F", "output": "end_x"}, params)
+    assert list(a.values) == list(r.values)
+    # The truth inside the intervals of the two unregularized stiffnesses (1 % noise, 40 points).
+    for e, t in zip(r.estimates[:2], (12, 18)):
+        assert e.lower95 <= t <= e.upper95, e
+
+
+@pytest.mark.skipif(not mbsgen._mbsgen.has_fit, reason="built without fit (Ceres Solver)")
+def test_fit_says_what_went_wrong(tmp_path):
+    path, _, _ = chain_data(tmp_path)
+    m = model(CHAIN, "full")
+    with pytest.warns(mbsgen.FitWarning, match="did not converge"):
+        r = m.fit(str(path), {"k1": (1, 100), "c1": (0.01, 1)}, input="F", output="end_x", max_iterations=1)
+    assert not r.converged and "did not converge" in r.warnings[0]
+    with pytest.raises(ValueError, match="unknown parameter 'k8'"):
+        m.fit(str(path), {"k8": (1, 2)}, input="F", output="end_x")
+    with pytest.raises(ValueError, match="not below the upper bound"):
+        m.fit(str(path), {"k1": (5, 1)}, input="F", output="end_x")
+    with pytest.raises(ValueError, match="which input and output"):
+        m.fit({"frequency_hz": [1.0], "response": [1.0]}, {"k1": (1, 100)})
+    with pytest.raises(ValueError, match="standard deviation that is not positive"):
+        m.fit({"frequency_hz": [1.0], "response": [1.0], "sigma_magnitude": -1, "input": "F", "output": "end_x"},
+              {"k1": (1, 100)})
+    with pytest.raises(mbsgen.Error, match="bad.csv:2:3: re: .nan. is not finite"):
+        bad = tmp_path / "bad.csv"
+        bad.write_text("frequency_hz,re,im\n1,nan,0\n")
+        m.fit(str(bad), {"k1": (1, 100)}, input="F", output="end_x")

@@ -179,13 +179,12 @@ std::vector<Solution> solve_all(const GeneratedModel& model, const MeasuredData&
       next = starts.size();
     }
   };
-  if (threads <= 1) {
-    work();
-  } else {
-    std::vector<std::thread> pool;
-    for (std::size_t t = 0; t < threads; ++t) pool.emplace_back(work);
-    for (auto& t : pool) t.join();
-  }
+  // The calling thread works too: a stop callback that only answers on the main thread (Python's
+  // signal check) is asked there.
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
   if (failure) std::rethrow_exception(failure);
   return out;
 }

@@ -9,6 +9,7 @@
 
 #include "mbsgen/runtime/error.hpp"
 #include "mbsgen/runtime/fit/fit.hpp"
+#include "mbsgen/runtime/model/generated_model.hpp"
 #include "model/text_file.hpp"
 
 namespace mbsgen {
@@ -225,7 +226,7 @@ MeasuredData read_measured_data_file(const std::string& path, const std::string&
 
 FitParameter parse_fit_parameter(const std::string& text) {
   const auto fail = [&](const std::string& what) -> void {
-    throw Error("--parameter " + quoted(text) + ": " + what +
+    throw NameError("--parameter " + quoted(text) + ": " + what +
                 " (expected NAME=LO:HI[:xF | :+-W][:lin], e.g. k=100:1e4:x2)");
   };
   const auto eq = text.find('=');
