@@ -212,7 +212,7 @@ TEST(TapeModel, AgreesWithTheCompiledKernelsOfEveryShippedModel) {
 // The tape's sensitivities by forward mode (issue 40 §2) against the symbolic sensitivity kernel,
 // on every shipped model that has one: the tapes with their symbolic kernels taken out, so that
 // forward mode answers, through GeneratedModel::linear_sensitivities as `modes --sensitivity`
-// uses it (the operating point's derivatives included). Two ways of differentiating, each in
+// uses it (the operating point's derivatives included; along the named parameters only). Two ways of differentiating, each in
 // double precision: they agree to the rounding of the chains of operations that compute them,
 // bounded here as 1e-13 of the largest entry of the two blocks (500 units in the last place;
 // measured on 2026-11-29: 2.4e-16 at most over the 10 models and every parameter).
@@ -254,6 +254,14 @@ TEST(TapeModel, ForwardSensitivitiesAgreeWithTheSymbolicKernel) {
     const auto a = by_tape.linear_sensitivities(by_tape.operating_point(), names);
     const auto b = by_kernel.linear_sensitivities(op, names);
     ASSERT_EQ(a.size(), b.size());
+    // Along two parameters only, in the other order (sensitivity_along: a pass per chosen
+    // parameter, issue 42): each direction's arithmetic is its own, so the very same numbers.
+    const auto two = by_tape.linear_sensitivities(by_tape.operating_point(), {names.back(), names.front()});
+    ASSERT_EQ(two.size(), 2u);
+    EXPECT_EQ(two[0].parameter, a.back().parameter);
+    EXPECT_TRUE(two[0].K == a.back().K && two[0].M == a.back().M && two[0].B == a.back().B && two[0].dy0 == a.back().dy0);
+    EXPECT_TRUE(two[1].K == a.front().K && two[1].Q == a.front().Q && two[1].C_y == a.front().C_y &&
+                two[1].dy0 == a.front().dy0);
     for (std::size_t j = 0; j < a.size(); ++j) {
       const std::string what = "d/d" + a[j].parameter;
       using S = mbsgen::MatrixSensitivity;

@@ -53,7 +53,8 @@ class FitEvaluator {
   Eigen::VectorXd lower_, upper_;
   std::vector<double> hz_;          // every frequency of the data, sorted, unique
   std::vector<std::vector<std::size_t>> at_;  // [data set][point] → index in hz_
-  std::vector<std::pair<Eigen::Index, Eigen::Index>> io_;  // [data set] (input, output)
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> io_;  // [data set] (input, output) in the restricted model
+  std::vector<Eigen::Index> inputs_, outputs_;  // the data's inputs and outputs (the model's indices)
   std::vector<int> priors_;         // fitted parameters with a prior
   int data_rows_ = 0;
   bool weighted_ = true;

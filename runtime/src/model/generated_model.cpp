@@ -463,10 +463,18 @@ std::vector<MatrixSensitivity> GeneratedModel::linear_sensitivities(const Operat
   }
   if (names.empty())
     for (Eigen::Index j = 0; j < s; ++j) chosen.push_back(j);
+  // Along the chosen parameters only when the kernels offer it (a tape: a forward-mode pass per
+  // parameter), else every parameter's derivatives, of which the chosen ones are kept.
+  const bool along = !names.empty() && k_.sensitivity_along &&
+                     (!k_.operating_point_sensitivity || k_.operating_point_sensitivity_along);
+  const Eigen::Index c = along ? static_cast<Eigen::Index>(chosen.size()) : s;
+  const std::vector<int> which(chosen.begin(), chosen.end());
   // The operating point's derivatives.
-  Eigen::MatrixXd dy0 = Eigen::MatrixXd::Zero(f, s), dyd0 = Eigen::MatrixXd::Zero(f, s);
-  if (k_.operating_point_sensitivity && f > 0 && s > 0) {
-    check_status(k_.operating_point_sensitivity(op.y0.data(), op.yd0.data(), p_.data(), dy0.data(), dyd0.data()),
+  Eigen::MatrixXd dy0 = Eigen::MatrixXd::Zero(f, c), dyd0 = Eigen::MatrixXd::Zero(f, c);
+  if (k_.operating_point_sensitivity && f > 0 && c > 0) {
+    check_status(along ? k_.operating_point_sensitivity_along(static_cast<int>(c), which.data(), op.y0.data(), op.yd0.data(),
+                                                                p_.data(), dy0.data(), dyd0.data())
+                       : k_.operating_point_sensitivity(op.y0.data(), op.yd0.data(), p_.data(), dy0.data(), dyd0.data()),
                  "operating_point_sensitivity", k_.model);
     if (k_.equilibrium) {  // dy0 holds dr: K dy0 = −dr
       const Eigen::PartialPivLU<Eigen::MatrixXd> lu(linear_model(op).K());
@@ -477,21 +485,26 @@ std::vector<MatrixSensitivity> GeneratedModel::linear_sensitivities(const Operat
       dy0 = -lu.solve(dy0);
     }
   }
-  auto sized = [&](Eigen::Index rows, Eigen::Index cols) { return std::vector<double>(static_cast<std::size_t>(rows * cols * s)); };
+  auto sized = [&](Eigen::Index rows, Eigen::Index cols) { return std::vector<double>(static_cast<std::size_t>(rows * cols * c)); };
   std::vector<double> dM = sized(f, f), dQ = sized(f, f), dK = sized(f, f), dB = sized(f, m), dCy = sized(r, f),
                       dCv = sized(r, f), dCa = sized(r, f), dD = sized(r, m), dB1 = sized(f, m), dB2 = sized(f, m),
                       dD1 = sized(r, m);
   double dummy[1] = {0};
   auto ptr = [&dummy](std::vector<double>& v) { return v.empty() ? dummy : v.data(); };
-  check_status(k_.sensitivity(op.y0.data(), op.yd0.data(), p_.data(), dy0.size() ? dy0.data() : dummy,
-                              dyd0.size() ? dyd0.data() : dummy, ptr(dM), ptr(dQ), ptr(dK), ptr(dB), ptr(dCy), ptr(dCv),
-                              ptr(dCa), ptr(dD), ptr(dB1), ptr(dB2), ptr(dD1)),
+  const double* dy = dy0.size() ? dy0.data() : dummy;
+  const double* dyd = dyd0.size() ? dyd0.data() : dummy;
+  check_status(along ? k_.sensitivity_along(static_cast<int>(c), which.data(), op.y0.data(), op.yd0.data(), p_.data(), dy, dyd,
+                                            ptr(dM), ptr(dQ), ptr(dK), ptr(dB), ptr(dCy), ptr(dCv), ptr(dCa), ptr(dD),
+                                            ptr(dB1), ptr(dB2), ptr(dD1))
+                     : k_.sensitivity(op.y0.data(), op.yd0.data(), p_.data(), dy, dyd, ptr(dM), ptr(dQ), ptr(dK), ptr(dB),
+                                      ptr(dCy), ptr(dCv), ptr(dCa), ptr(dD), ptr(dB1), ptr(dB2), ptr(dD1)),
                "sensitivity", k_.model);
   const std::vector<std::string> all = name_list(k_.parameter_names, k_.n_parameters);
   std::vector<MatrixSensitivity> out;
-  for (Eigen::Index j : chosen) {
+  for (std::size_t q = 0; q < chosen.size(); ++q) {
+    const Eigen::Index jj = chosen[q], j = along ? static_cast<Eigen::Index>(q) : jj;  // j: the block
     MatrixSensitivity d;
-    d.parameter = known[static_cast<std::size_t>(j)];
+    d.parameter = known[static_cast<std::size_t>(jj)];
     d.value = p_[static_cast<std::size_t>(std::find(all.begin(), all.end(), d.parameter) - all.begin())];
     d.M = block(dM, f, f, j), d.Q = block(dQ, f, f, j), d.K = block(dK, f, f, j), d.B = block(dB, f, m, j);
     d.C_y = block(dCy, r, f, j), d.C_v = block(dCv, r, f, j);

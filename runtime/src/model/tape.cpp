@@ -272,22 +272,29 @@ struct TapeModel::Impl {
   /// The sensitivity kernels by forward mode over linear, output_terms, excitation, operating_point
   /// and residual, by every parameter (a tape without the symbolic ones; issue 40 §2).
   bool forward_sensitivity = false;
-  int sensitivity_by_forward_mode(void* const* argv) const;
-  int operating_point_sensitivity_by_forward_mode(void* const* argv) const;
+  // argv as the kernels' (after count and which in the *_along forms); `directions` the
+  // parameters' seeds, s × (number of directions), column-major.
+  int sensitivity_by_forward_mode(void* const* argv, const std::vector<double>& directions) const;
+  int operating_point_sensitivity_by_forward_mode(void* const* argv, const std::vector<double>& directions) const;
+  std::vector<double> directions(int count, const int* which) const;
 };
 
-// The s×s identity, column-major: the directions e_j of the parameters.
-static std::vector<double> identity(std::size_t s) {
-  std::vector<double> e(s * s, 0.0);
-  for (std::size_t j = 0; j < s; ++j) e[j * s + j] = 1;
+// The directions e_j of the parameters, column-major s × count: every parameter (which null, the
+// identity) or the chosen ones.
+std::vector<double> TapeModel::Impl::directions(int count, const int* which) const {
+  const std::size_t s = parameters.size(), c = which ? static_cast<std::size_t>(count) : s;
+  std::vector<double> e(s * c, 0.0);
+  for (std::size_t j = 0; j < c; ++j) {
+    const std::size_t i = which ? static_cast<std::size_t>(which[j]) : j;
+    if (i < s) e[j * s + i] = 1;
+  }
   return e;
 }
 
 // sensitivity(y0, yd0, p, dy0, dyd0, dM, dQ, dK, dB, dCy, dCv, dCa, dD, dB1, dB2, dD1): the total
 // derivatives by each parameter p_j of the linear matrices, along (dy0_j, dyd0_j, e_j).
-int TapeModel::Impl::sensitivity_by_forward_mode(void* const* argv) const {
-  const std::size_t s = parameters.size();
-  const std::vector<double> directions = identity(s);
+int TapeModel::Impl::sensitivity_by_forward_mode(void* const* argv, const std::vector<double>& directions) const {
+  const std::size_t s = parameters.empty() ? 0 : directions.size() / parameters.size();
   auto in = [&](std::size_t i) { return static_cast<const double*>(argv[i]); };
   auto out = [&](std::size_t i) { return static_cast<double*>(argv[i]); };
   int status = 0;
@@ -304,9 +311,9 @@ int TapeModel::Impl::sensitivity_by_forward_mode(void* const* argv) const {
 
 // operating_point_sensitivity(y0, yd0, p, dy0 | dr, dyd0): a given point's derivatives by the
 // parameters; for a static equilibrium dr = ∂r/∂p + Q dyd0 (the caller solves K dy0 = −dr).
-int TapeModel::Impl::operating_point_sensitivity_by_forward_mode(void* const* argv) const {
-  const std::size_t s = parameters.size();
-  const std::vector<double> directions = identity(s);
+int TapeModel::Impl::operating_point_sensitivity_by_forward_mode(void* const* argv,
+                                                                  const std::vector<double>& directions) const {
+  const std::size_t s = parameters.empty() ? 0 : directions.size() / parameters.size();
   const double* p = static_cast<const double*>(argv[2]);
   double* first = static_cast<double*>(argv[3]);
   double* dyd0 = static_cast<double*>(argv[4]);
@@ -337,7 +344,16 @@ template <int S, int K, class... A>
 int by_forward_mode(A... a) {
   void* argv[] = {const_cast<void*>(static_cast<const void*>(a))...};
   const TapeModel::Impl* t = g_slots[S].load(std::memory_order_acquire);
-  return K == kSensitivity ? t->sensitivity_by_forward_mode(argv) : t->operating_point_sensitivity_by_forward_mode(argv);
+  const std::vector<double> e = t->directions(0, nullptr);
+  return K == kSensitivity ? t->sensitivity_by_forward_mode(argv, e) : t->operating_point_sensitivity_by_forward_mode(argv, e);
+}
+
+template <int S, int K, class... A>
+int along_forward_mode(int count, const int* which, A... a) {
+  void* argv[] = {const_cast<void*>(static_cast<const void*>(a))...};
+  const TapeModel::Impl* t = g_slots[S].load(std::memory_order_acquire);
+  const std::vector<double> e = t->directions(count, which);
+  return K == kSensitivity ? t->sensitivity_by_forward_mode(argv, e) : t->operating_point_sensitivity_by_forward_mode(argv, e);
 }
 
 template <int S>
@@ -345,6 +361,8 @@ void bind(ModelKernels& m, const TapeModel::Impl& t) {
   if (t.forward_sensitivity) {
     m.sensitivity = &by_forward_mode<S, kSensitivity>;
     m.operating_point_sensitivity = &by_forward_mode<S, kOperatingPointSensitivity>;
+    m.sensitivity_along = &along_forward_mode<S, kSensitivity>;
+    m.operating_point_sensitivity_along = &along_forward_mode<S, kOperatingPointSensitivity>;
   }
   const auto& k = t.known;
   if (k[kOperatingPoint]) m.operating_point = &call<S, kOperatingPoint>;

@@ -92,20 +92,66 @@ std::vector<std::vector<EigenvalueSensitivity>> eigenvalue_sensitivities(
   return out;
 }
 
+namespace {
+
+// One matrix of a model or derivative with its shape checked (part()), and whether it is exactly
+// zero: a derivative by a stiffness has dM = dQ = 0, and its terms are skipped.
+struct Part {
+  Eigen::MatrixXd a;
+  bool zero = true;
+};
+
+struct Parts {
+  Part M, Q, K, B, Cy, Cv, Ca, D, B1, B2, D1;
+};
+
+Part make_part(Eigen::MatrixXd a) {
+  Part p;
+  p.zero = a.size() == 0 || (a.array() == 0.0).all();
+  p.a = std::move(a);
+  return p;
+}
+
+using CM = Eigen::MatrixXcd;
+using Cx = std::complex<double>;
+
+// x0 + iw x1 − w² x2 of three real matrices into `out` (sized rows × cols), skipping zero parts.
+void combine(CM& out, Eigen::Index rows, Eigen::Index cols, const Part& x0, const Part& x1, const Part& x2, double w) {
+  out.resize(rows, cols);
+  out.setZero();
+  if (!x0.zero) out.real() += x0.a;
+  if (!x1.zero) out.imag() += w * x1.a;
+  if (!x2.zero) out.real() -= (w * w) * x2.a;
+}
+
+// (x0 + iw x1 − w² x2) X for real x0, x1, x2 and complex X: real products, zero parts skipped.
+void apply(CM& out, const Part& x0, const Part& x1, const Part& x2, double w, const CM& X, Eigen::Index rows) {
+  out.setZero(rows, X.cols());
+  const Eigen::MatrixXd Xr = X.real(), Xi = X.imag();
+  const auto add = [&](const Part& x, Cx factor) {
+    if (x.zero) return;
+    const Eigen::MatrixXd re = x.a * Xr, im = x.a * Xi;
+    out.real() += factor.real() * re - factor.imag() * im;
+    out.imag() += factor.real() * im + factor.imag() * re;
+  };
+  add(x0, 1.0);
+  add(x1, Cx(0, w));
+  add(x2, -w * w);
+}
+
+}  // namespace
+
 FrequencyResponseSensitivity frequency_response_sensitivity(const LinearModel& model,
                                                             const std::vector<MatrixSensitivity>& sensitivities,
                                                             const std::vector<double>& frequencies_hz) {
-  using C = std::complex<double>;
-  using CM = Eigen::MatrixXcd;
   const Eigen::Index f = model.size(), m = model.num_inputs(), r = model.num_outputs();
-  struct Parts {
-    Eigen::MatrixXd M, Q, K, B, Cy, Cv, Ca, D, B1, B2, D1;
-  };
   auto parts = [&](const MatrixSensitivity& s, const std::string& name) {
-    return Parts{part(s.M, f, f, "M", name),   part(s.Q, f, f, "Q", name),   part(s.K, f, f, "K", name),
-                 part(s.B, f, m, "B", name),   part(s.C_y, r, f, "C_y", name), part(s.C_v, r, f, "C_v", name),
-                 part(s.C_a, r, f, "C_a", name), part(s.D, r, m, "D", name), part(s.B1, f, m, "B1", name),
-                 part(s.B2, f, m, "B2", name), part(s.D1, r, m, "D1", name)};
+    return Parts{make_part(part(s.M, f, f, "M", name)),     make_part(part(s.Q, f, f, "Q", name)),
+                 make_part(part(s.K, f, f, "K", name)),     make_part(part(s.B, f, m, "B", name)),
+                 make_part(part(s.C_y, r, f, "C_y", name)), make_part(part(s.C_v, r, f, "C_v", name)),
+                 make_part(part(s.C_a, r, f, "C_a", name)), make_part(part(s.D, r, m, "D", name)),
+                 make_part(part(s.B1, f, m, "B1", name)),   make_part(part(s.B2, f, m, "B2", name)),
+                 make_part(part(s.D1, r, m, "D1", name))};
   };
   MatrixSensitivity own;  // the model's own matrices, in the same form
   own.M = model.M(), own.Q = model.Q(), own.K = model.K(), own.B = model.B(), own.C_y = model.C_y();
@@ -119,26 +165,42 @@ FrequencyResponseSensitivity frequency_response_sensitivity(const LinearModel& m
   out.frequencies_hz = frequencies_hz;
   out.derivative.assign(sensitivities.size(), {});
   const double u = std::numeric_limits<double>::epsilon();
+  // Work space reused over the frequencies (each analysis used to allocate its temporaries anew).
+  CM A, Bw, Cw, X, Z, W, dAX, dBw, dCw, dZ;
+  Eigen::PartialPivLU<CM> lu(f);
   for (double hz : frequencies_hz) {
     if (!std::isfinite(hz)) throw NonFiniteError("frequency_response_sensitivity: frequency " + std::to_string(hz) + " Hz");
     const double w = 2 * M_PI * hz;
-    const C iw(0, w);
-    auto A_of = [&](const Parts& X) -> CM { return X.K.cast<C>() + iw * X.Q.cast<C>() - w * w * X.M.cast<C>(); };
-    auto B_of = [&](const Parts& X) -> CM { return X.B.cast<C>() + iw * X.B1.cast<C>() - w * w * X.B2.cast<C>(); };
-    auto C_of = [&](const Parts& X) -> CM { return X.Cy.cast<C>() + iw * X.Cv.cast<C>() - w * w * X.Ca.cast<C>(); };
-    auto D_of = [&](const Parts& X) -> CM { return X.D.cast<C>() + iw * X.D1.cast<C>(); };
-    const Eigen::PartialPivLU<CM> lu(A_of(P));
+    combine(A, f, f, P.K, P.Q, P.M, w);
+    lu.compute(A);
     const double rc = f ? lu.rcond() : 1.0;
     out.rcond.push_back(rc);
     const bool singular = !(rc > u);
-    const CM X = lu.solve(B_of(P)), Cw = C_of(P);
-    CM Z = Cw * X + D_of(P);
-    if (singular) Z.setConstant(C(kNaN, kNaN));
+    combine(Bw, f, m, P.B, P.B1, P.B2, w);
+    combine(Cw, r, f, P.Cy, P.Cv, P.Ca, w);
+    X = lu.solve(Bw);
+    Z = Cw * X;
+    if (!P.D.zero) Z.real() += P.D.a;
+    if (!P.D1.zero) Z.imag() += w * P.D1.a;
+    if (singular) Z.setConstant(Cx(kNaN, kNaN));
     out.response.push_back(Z);
+    if (dP.empty()) continue;
+    // dẑ = dC X + C(Ω) A⁻¹ (dB(Ω) − dA X) + dD.
     for (std::size_t j = 0; j < dP.size(); ++j) {
-      CM dZ = C_of(dP[j]) * X + Cw * lu.solve(B_of(dP[j]) - A_of(dP[j]) * X) + D_of(dP[j]);
-      if (singular) dZ.setConstant(C(kNaN, kNaN));
-      out.derivative[j].push_back(std::move(dZ));
+      const Parts& d = dP[j];
+      apply(dAX, d.K, d.Q, d.M, w, X, f);
+      combine(dBw, f, m, d.B, d.B1, d.B2, w);
+      dBw -= dAX;
+      W = lu.solve(dBw);
+      dZ.noalias() = Cw * W;
+      if (!(d.Cy.zero && d.Cv.zero && d.Ca.zero)) {
+        apply(dCw, d.Cy, d.Cv, d.Ca, w, X, r);
+        dZ += dCw;
+      }
+      if (!d.D.zero) dZ.real() += d.D.a;
+      if (!d.D1.zero) dZ.imag() += w * d.D1.a;
+      if (singular) dZ.setConstant(Cx(kNaN, kNaN));
+      out.derivative[j].push_back(dZ);
     }
   }
   return out;

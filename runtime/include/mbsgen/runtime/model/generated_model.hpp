@@ -144,6 +144,17 @@ struct ModelKernels {
   /// How the kernels are evaluated (issue 40 §1): null for compiled code, "tape" for a
   /// TapeModel (model/tape.hpp), which `info` reports. Trailing.
   const char* evaluation = nullptr;
+  /// `sensitivity` and `operating_point_sensitivity` along chosen parameters only (null: not
+  /// offered): the same arguments after `count` and `which` (0-based indices into the sensitivity
+  /// parameters), dy0, dyd0 and every derivative with `count` blocks. A tape offers them: its
+  /// forward mode costs a pass per parameter, and a fit of 10 of the middle ear's 87 parameters
+  /// needs 10 (issue 42); compiled kernels derive every parameter at once. Trailing.
+  int (*sensitivity_along)(int count, const int* which, const double* y0, const double* yd0, const double* p,
+                           const double* dy0, const double* dyd0, double* dM, double* dQ, double* dK, double* dB,
+                           double* dCy, double* dCv, double* dCa, double* dD, double* dB1, double* dB2,
+                           double* dD1) = nullptr;
+  int (*operating_point_sensitivity_along)(int count, const int* which, const double* y0, const double* yd0,
+                                           const double* p, double* dy0, double* dyd0) = nullptr;
 };
 
 /// True when input j of the kernels prescribes motion (input_kinds, prescribed motion).
