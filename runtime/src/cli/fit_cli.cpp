@@ -42,8 +42,12 @@ void write_table(std::ostream& out, const ModelKernels& k, const FitResult& f) {
         << "  " << (f.log_space[j] ? "log   " : "linear") << "  " << (f.at_bound[j].empty() ? "-" : f.at_bound[j]) << "\n";
   }
   out << "# identifiability (Fisher information of the data, relative coordinates; weakest first):\n";
-  for (const FisherDirection& d : f.fisher)
+  std::string said;  // the directions of zero eigenvalue share one description: printed once
+  for (const FisherDirection& d : f.fisher) {
+    if (d.description == said) continue;
+    said = d.description;
     out << "#   " << d.verdict << ": sigma " << short_num(d.sigma) << ": " << d.description << "\n";
+  }
   if (f.minima.size() > 1) {
     out << "# distinct local minima (cost, starts ending there):\n";
     for (const LocalMinimum& m : f.minima) out << "#   " << short_num(m.cost) << "  " << m.starts << "\n";

@@ -258,33 +258,70 @@ std::string describe_direction(const std::vector<std::string>& names, const Vect
 }
 
 // The Fisher information of the data alone in relative coordinates, by eigenvalue (weakest
-// first), each direction judged and named.
+// first), each direction judged and named. A parameter whose column of J is zero (to the
+// threshold below which an eigenvalue counts as zero: ‖J_j‖² ≤ 4nε ‖J‖²_max, the response's own
+// rounding reaching 1e-8 of it where A(Ω) is ill-conditioned) has no effect on the data at all: it is its own direction, said
+// so, and the others are analysed without it (otherwise the null space's basis, which any
+// rotation of it is as good as, would mix such parameters into arbitrary combinations).
 std::vector<FisherDirection> fisher_analysis(const detail::FitEvaluator& e, const MatrixXd& J_data, const VectorXd& theta,
                                              double s2) {
   MatrixXd Jr = J_data;
   const VectorXd p = e.values(theta);
-  for (int j = 0; j < e.cols(); ++j)
+  const int n = e.cols();
+  for (int j = 0; j < n; ++j)
     if (!e.log_space(j)) Jr.col(j) *= p[j] != 0 ? std::abs(p[j]) : e.theta_upper()[j] - e.theta_lower()[j];
-  const MatrixXd F = Jr.transpose() * Jr / s2;
-  const Eigen::SelfAdjointEigenSolver<MatrixXd> es(F);
+  const double largest = Jr.size() ? Jr.colwise().norm().maxCoeff() : 0.0;
   std::vector<FisherDirection> out;
-  const double top = std::max(es.eigenvalues().maxCoeff(), 0.0);
+  std::vector<int> live;
+  for (int j = 0; j < n; ++j) {
+    if (Jr.col(j).squaredNorm() > 4.0 * n * std::numeric_limits<double>::epsilon() * largest * largest) {
+      live.push_back(j);
+      continue;
+    }
+    FisherDirection d;
+    d.sigma = kInf;
+    d.direction = VectorXd::Unit(n, j);
+    d.verdict = "not identified";
+    d.description = describe_direction(e.names(), d.direction, d.sigma, d.verdict);
+    out.push_back(std::move(d));
+  }
+  MatrixXd Jl(Jr.rows(), static_cast<Eigen::Index>(live.size()));
+  for (std::size_t k = 0; k < live.size(); ++k) Jl.col(static_cast<Eigen::Index>(k)) = Jr.col(live[k]);
+  const MatrixXd F = Jl.transpose() * Jl / s2;
+  const Eigen::SelfAdjointEigenSolver<MatrixXd> es(F);
+  const double top = F.size() ? std::max(es.eigenvalues().maxCoeff(), 0.0) : 0.0;
   for (int k = 0; k < F.rows(); ++k) {
     FisherDirection d;
     d.eigenvalue = es.eigenvalues()[k];
     // Eigenvalues within rounding of zero (n ε λ_max) are zero: nothing identifies that direction.
     const bool zero = d.eigenvalue <= 4.0 * F.rows() * std::numeric_limits<double>::epsilon() * top;
     d.sigma = zero ? kInf : 1.0 / std::sqrt(d.eigenvalue);
-    d.direction = es.eigenvectors().col(k);
-    const Eigen::Index big = [&] {
-      Eigen::Index i = 0;
-      d.direction.cwiseAbs().maxCoeff(&i);
-      return i;
-    }();
+    d.direction = VectorXd::Zero(n);
+    for (std::size_t q = 0; q < live.size(); ++q) d.direction[live[q]] = es.eigenvectors()(static_cast<Eigen::Index>(q), k);
+    Eigen::Index big = 0;
+    d.direction.cwiseAbs().maxCoeff(&big);
     if (d.direction[big] < 0) d.direction = -d.direction;
     d.verdict = d.sigma <= 0.1 ? "identified" : d.sigma <= 1.0 ? "weakly identified" : "not identified";
-    d.description = describe_direction(e.names(), d.direction, d.sigma, d.verdict);
+    d.description = zero ? "" : describe_direction(e.names(), d.direction, d.sigma, d.verdict);
     out.push_back(std::move(d));
+  }
+  // The directions with a zero eigenvalue span a space whose basis any rotation gives as well:
+  // each is described by that space, through how much of each parameter lies in it.
+  std::vector<int> null;
+  for (std::size_t k = 0; k < out.size(); ++k)
+    if (std::isinf(out[k].sigma) && out[k].description.empty()) null.push_back(static_cast<int>(k));
+  if (!null.empty()) {
+    std::string whole, part;
+    for (int j = 0; j < n; ++j) {
+      double share = 0;  // ‖projection of e_j onto the null space‖²
+      for (int k : null) share += out[static_cast<std::size_t>(k)].direction[j] * out[static_cast<std::size_t>(k)].direction[j];
+      if (share > 0.99) whole += (whole.empty() ? "" : ", ") + e.names()[static_cast<std::size_t>(j)];
+      else if (share > 0.01) part += (part.empty() ? "" : ", ") + e.names()[static_cast<std::size_t>(j)];
+    }
+    const std::string text = std::to_string(null.size()) + " direction" + (null.size() > 1 ? "s" : "") +
+                             " the data do not depend on at all" + (whole.empty() ? "" : "; entirely in them: " + whole) +
+                             (part.empty() ? "" : "; partly (only some combinations of these are identified): " + part);
+    for (int k : null) out[static_cast<std::size_t>(k)].description = text;
   }
   return out;
 }
