@@ -76,5 +76,5 @@ headers_from_deb() {
 headers_from_deb libsundials-dev libsundials-cvode6 cvode/cvode.h build/deps/sundials
 # Ceres Solver (the solver of `fit`, issue 42): the runtime library libceres3 and its headers;
 # libceres-dev itself depends on SuiteSparse's and ATLAS's development packages and GraphBLAS
-# (255 MB installed on Debian 12, against about 30 MB for libceres3 with glog's headers).
+# (255 MB installed on Debian 12, against 22 MB for libceres3 with glog's headers).
 headers_from_deb libceres-dev libceres3 ceres/ceres.h build/deps/ceres
