@@ -12,10 +12,12 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 #include "cli/bode_plot.hpp"
 #include "cli/cli_files.hpp"
 #include "cli/cli_output.hpp"
+#include "cli/study_cluster.hpp"
 #include "mbsgen/runtime/model/tape.hpp"
 #include "mbsgen/runtime/spectral/sensitivity.hpp"
 
@@ -205,49 +207,54 @@ CLI::App* add_fit(CLI::App& app, FitCliOptions& o) {
   return fit;
 }
 
-int run_fit(const ModelKernels& k, const FitCliOptions& o, std::ostream& out, std::ostream& err) {
-  GeneratedModel model(k);
-  for (const std::string& a : o.set) model.set(a);
+namespace {
+
+// What a fit reads and where it writes, checked before any work (the files: not after the fit).
+struct FitInputs {
   MeasuredData data;
+  std::vector<FitParameter> params;
+  std::vector<OutputFile> files;
+};
+
+FitInputs prepare(const FitCliOptions& o, GeneratedModel& model, bool writes) {
+  FitInputs in;
+  for (const std::string& a : o.set) model.set(a);
   for (const std::string& file : o.data) {
     MeasuredData d = read_measured_data_file(file, o.input, o.output);
-    for (auto& r : d.responses) data.responses.push_back(std::move(r));
-    for (auto& m : d.modal) data.modal.push_back(std::move(m));
+    for (auto& r : d.responses) in.data.responses.push_back(std::move(r));
+    for (auto& m : d.modal) in.data.modal.push_back(std::move(m));
   }
-  std::vector<FitParameter> params;
-  for (const std::string& p : o.parameters) params.push_back(parse_fit_parameter(p));
-  std::vector<OutputFile> files;
+  for (const std::string& p : o.parameters) in.params.push_back(parse_fit_parameter(p));
+  for (const std::string& name : o.profile)
+    for (char c : name)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_'))
+        throw NameError("fit --profile '" + name + "': not a parameter name (letters, digits and '_')");
+  if (!o.out_dir.empty()) {
+    in.files.push_back({std::filesystem::path(o.out_dir) / "fit.json", ""});
+    in.files.push_back({std::filesystem::path(o.out_dir) / "fit_points.csv", ""});
+    for (const std::string& name : o.profile)
+      in.files.push_back({std::filesystem::path(o.out_dir) / ("fit_profile_" + name + ".csv"), ""});
+  }
+  if (!writes) return in;  // the files are rank 0's
   if (!o.out_dir.empty()) {
     refuse_non_directory(o.out_dir, "fit --out");
-    files.push_back({std::filesystem::path(o.out_dir) / "fit.json", ""});
-    files.push_back({std::filesystem::path(o.out_dir) / "fit_points.csv", ""});
-    for (const std::string& name : o.profile) {
-      for (char c : name)
-        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_'))
-          throw Error("fit --profile '" + name + "': a name for a file name has only letters, digits and '_'");
-      files.push_back({std::filesystem::path(o.out_dir) / ("fit_profile_" + name + ".csv"), ""});
-    }
     std::vector<std::filesystem::path> paths;
-    for (const auto& f : files) paths.push_back(f.path);
-    refuse_foreign_files(paths, kMarker, "fit");  // before the work, not after
+    for (const auto& f : in.files) paths.push_back(f.path);
+    refuse_foreign_files(paths, kMarker, "fit");
   }
   if (!o.plot.empty()) refuse_special_file(o.plot, "fit --plot");
-  FitOptions opt;
-  opt.starts = o.starts;
-  opt.threads = o.threads;
-  opt.seed = o.seed;
-  opt.max_iterations = o.max_iterations;
-  opt.optimize = !o.no_fit;
-  opt.profile = o.profile;
-  opt.profile_points = o.profile_points;
-  const FitResult f = fit(model, data, params, opt);
+  return in;
+}
+
+void write_outputs(const ModelKernels& k, const FitCliOptions& o, const GeneratedModel& model, FitInputs& in,
+                   const FitResult& f, std::ostream& out) {
   if (o.format == "json")
     out << json_result(k, f);
   else
     write_table(out, k, f);
-  if (!files.empty()) {
-    files[0].content = json_result(k, f);
-    files[1].content = points_csv(k, f);
+  if (!in.files.empty()) {
+    in.files[0].content = json_result(k, f);
+    in.files[1].content = points_csv(k, f);
     for (std::size_t q = 0; q < f.profiles.size(); ++q) {
       std::ostringstream s;
       s << "# " << kMarker << ": model " << csv_field(k.model) << ", profile likelihood of " << f.profiles[q].parameter
@@ -255,16 +262,52 @@ int run_fit(const ModelKernels& k, const FitCliOptions& o, std::ostream& out, st
         << f.profiles[q].parameter << ",cost,converged\n";
       for (const ProfilePoint& p : f.profiles[q].points)
         s << num(p.value, false) << "," << num(p.cost, false) << "," << (p.converged ? 1 : 0) << "\n";
-      files[2 + q].content = s.str();
+      in.files[2 + q].content = s.str();
     }
-    write_all_or_nothing(files, kMarker, "fit");
+    write_all_or_nothing(in.files, kMarker, "fit");
   }
-  if (!o.plot.empty() && !data.responses.empty()) {
+  if (!o.plot.empty() && !in.data.responses.empty()) {
     FitPlot plot;
     plot.title = "fit of '" + std::string(k.model) + "': data, start (cost " + short_num(f.initial_cost) + ") and fit (cost " +
                  short_num(f.cost) + (f.converged ? ")" : ", NOT CONVERGED)");
-    plot_fit(o.plot, model, f, data, plot);
+    plot_fit(o.plot, model, f, in.data, plot);
   }
+}
+
+}  // namespace
+
+int run_fit(const ModelKernels& k, const FitCliOptions& o, std::ostream& out, std::ostream& err) {
+  // Under mpirun the ranks share the starts (FitOptions::share); every rank checks the same input
+  // and all stop together when one cannot go on (as a study does: no rank left waiting).
+  Cluster cluster;
+  GeneratedModel model(k);
+  FitInputs in;
+  std::exception_ptr problem;
+  try {
+    in = prepare(o, model, cluster.rank() == 0);
+  } catch (...) {
+    problem = std::current_exception();
+  }
+  if (cluster.any(problem != nullptr)) {
+    if (problem) std::rethrow_exception(problem);
+    return 1;
+  }
+  FitOptions opt;
+  opt.starts = o.starts;
+  opt.threads = o.threads > 0 ? o.threads
+                              : std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / cluster.local_size());
+  opt.seed = o.seed;
+  opt.max_iterations = o.max_iterations;
+  opt.optimize = !o.no_fit;
+  opt.profile = o.profile;
+  opt.profile_points = o.profile_points;
+  opt.rank = cluster.rank();
+  opt.ranks = cluster.size();
+  opt.share = [&cluster](const std::vector<double>& v) { return cluster.all_gather(v); };
+  const FitResult f = fit(model, in.data, in.params, opt);
+  if (cluster.rank() != 0) return f.converged ? 0 : 3;
+  if (cluster.size() > 1) out << "# the starts on " << cluster.description() << "\n";
+  write_outputs(k, o, model, in, f, out);
   if (!f.converged) {
     err << "fit: the fit did not converge (" << f.termination << "): the values printed are where it stopped, not a minimum\n";
     return 3;

@@ -127,6 +127,22 @@ bool Cluster::any(bool flag) const {
   return flag;
 }
 
+std::vector<double> Cluster::all_gather(const std::vector<double>& local) const {
+#ifdef MBSGEN_WITH_MPI
+  if (size_ > 1) {
+    const int n = static_cast<int>(local.size());
+    std::vector<int> counts(static_cast<std::size_t>(size_)), offsets(static_cast<std::size_t>(size_));
+    MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+    long total = 0;
+    for (int r = 0; r < size_; ++r) offsets[static_cast<std::size_t>(r)] = static_cast<int>(total), total += counts[static_cast<std::size_t>(r)];
+    std::vector<double> all(static_cast<std::size_t>(total));
+    MPI_Allgatherv(local.data(), n, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+    return all;
+  }
+#endif
+  return local;
+}
+
 StudyResults Cluster::gather(StudyResults local) const {
 #ifdef MBSGEN_WITH_MPI
   if (size_ > 1) {

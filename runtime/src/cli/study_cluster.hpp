@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "mbsgen/runtime/study/study.hpp"
 
@@ -29,6 +30,9 @@ class Cluster {
   /// Rank 0: every rank's results appended in rank order (the ranks hold consecutive ranges);
   /// the other ranks: their own results, unchanged. Timings are summed.
   StudyResults gather(StudyResults local) const;
+  /// Every rank's vector concatenated in rank order, on every rank (one process: local). For the
+  /// starts of a fit (issue 42).
+  std::vector<double> all_gather(const std::vector<double>& local) const;
 
  private:
   int rank_ = 0, size_ = 1, local_size_ = 1;

@@ -189,6 +189,59 @@ std::vector<Solution> solve_all(const GeneratedModel& model, const MeasuredData&
   return out;
 }
 
+// The starts of this process (i mod ranks = rank), solved, and every process's shared: each
+// solution packed as (index, cost, converged, iterations, evaluations, θ, the message's length and
+// bytes), after a flag for a process that failed.
+std::vector<Solution> solve_starts(const GeneratedModel& model, const MeasuredData& data,
+                                   const std::vector<FitParameter>& params, const std::vector<VectorXd>& starts,
+                                   const FitOptions& o) {
+  if (o.ranks <= 1 || !o.share) return solve_all(model, data, params, starts, o);
+  std::vector<VectorXd> mine;
+  std::vector<std::size_t> index;
+  for (std::size_t i = 0; i < starts.size(); ++i)
+    if (static_cast<int>(i % static_cast<std::size_t>(o.ranks)) == o.rank) mine.push_back(starts[i]), index.push_back(i);
+  std::vector<Solution> local;
+  std::string failure;
+  try {
+    if (!mine.empty()) local = solve_all(model, data, params, mine, o);
+  } catch (const std::exception& e) {
+    failure = e.what();
+  }
+  std::vector<double> pack{failure.empty() ? 0.0 : 1.0, static_cast<double>(local.size())};
+  for (std::size_t k = 0; k < local.size(); ++k) {
+    const Solution& x = local[k];
+    pack.insert(pack.end(), {static_cast<double>(index[k]), x.cost, x.converged ? 1.0 : 0.0, static_cast<double>(x.iterations),
+                             static_cast<double>(x.evaluations)});
+    pack.insert(pack.end(), x.theta.data(), x.theta.data() + x.theta.size());
+    pack.push_back(static_cast<double>(x.termination.size()));
+    for (char c : x.termination) pack.push_back(static_cast<unsigned char>(c));
+  }
+  const std::vector<double> all = o.share(pack);
+  std::vector<Solution> out(starts.size());
+  bool failed = false;
+  const auto n = static_cast<std::size_t>(starts.front().size());
+  for (std::size_t at = 0; at + 1 < all.size();) {
+    failed = failed || all[at] != 0;
+    const auto count = static_cast<std::size_t>(all[at + 1]);
+    at += 2;
+    for (std::size_t k = 0; k < count; ++k) {
+      Solution x;
+      const auto i = static_cast<std::size_t>(all[at]);
+      x.cost = all[at + 1];
+      x.converged = all[at + 2] != 0;
+      x.iterations = static_cast<int>(all[at + 3]);
+      x.evaluations = static_cast<int>(all[at + 4]);
+      x.theta = Eigen::Map<const VectorXd>(all.data() + at + 5, static_cast<Eigen::Index>(n));
+      at += 5 + n;
+      const auto length = static_cast<std::size_t>(all[at++]);
+      for (std::size_t c = 0; c < length; ++c) x.termination += static_cast<char>(static_cast<int>(all[at++]));
+      out[i] = std::move(x);
+    }
+  }
+  if (failed) throw Error("fit: a process failed" + (failure.empty() ? std::string(" (another rank)") : ": " + failure));
+  return out;
+}
+
 // Distinct local minima: solutions within 1e-6 relative cost and 1e-3 in every θ are one.
 std::vector<LocalMinimum> distinct_minima(const detail::FitEvaluator& e, std::vector<Solution> s) {
   std::sort(s.begin(), s.end(), [](const Solution& a, const Solution& b) { return a.cost < b.cost; });
@@ -492,7 +545,7 @@ FitResult fit(const GeneratedModel& model, const MeasuredData& data, const std::
   f.initial_cost = 0.5 * r.squaredNorm();
   VectorXd theta = theta0;
   if (options.optimize) {
-    const std::vector<Solution> s = solve_all(model, data, parameters, starting_points(e, theta0, options), options);
+    const std::vector<Solution> s = solve_starts(model, data, parameters, starting_points(e, theta0, options), options);
     const auto best = std::min_element(s.begin(), s.end(), [](const Solution& a, const Solution& b) { return a.cost < b.cost; });
     if (!std::isfinite(best->cost)) throw Error("fit: no start reached a point where the model can be evaluated");
     theta = best->theta;

@@ -113,6 +113,11 @@ struct FitOptions {
   std::vector<std::string> profile;  ///< parameters whose profile likelihood is traced
   int profile_points = 21;
   std::function<bool()> stop;        ///< polled between iterations; true ends the fit (Stopped)
+  /// Several processes (MPI ranks): each solves the starts i with i mod ranks = rank, and share
+  /// (an all-gather: every rank's vector concatenated in rank order, on every rank) hands each the
+  /// others'; every rank then has the same results, equal to one process's.
+  int rank = 0, ranks = 1;
+  std::function<std::vector<double>(const std::vector<double>&)> share;
 };
 
 /// A distinct local minimum among the starts.
