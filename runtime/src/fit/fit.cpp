@@ -34,6 +34,9 @@ const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The residuals and Jacobian for Ceres (one parameter block θ). An evaluation the model refuses
 // (unphysical values, no equilibrium) is an unsuccessful step, never an exception through Ceres.
+// Ceres evaluates a trial point without the Jacobian and, when it accepts the step, the same
+// point again with it: the Jacobian is computed with the residuals and kept for that second
+// call (a response less per step; a rejected step wastes a Jacobian, and LM rejects few).
 class Cost final : public ceres::CostFunction {
  public:
   explicit Cost(detail::FitEvaluator& e) : e_(e) {
@@ -42,18 +45,23 @@ class Cost final : public ceres::CostFunction {
   }
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const Eigen::Map<const VectorXd> theta(parameters[0], e_.cols());
-    VectorXd r;
-    MatrixXd J;
-    const bool want = jacobians != nullptr && jacobians[0] != nullptr;
-    if (!e_.evaluate(theta, r, want ? &J : nullptr)) return false;
-    Eigen::Map<VectorXd>(residuals, r.size()) = r;
-    if (want)
-      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(jacobians[0], J.rows(), J.cols()) = J;
+    if (!(kept_ && theta == theta_)) {
+      kept_ = false;
+      if (!e_.evaluate(theta, r_, &J_)) return false;
+      theta_ = theta;
+      kept_ = true;
+    }
+    Eigen::Map<VectorXd>(residuals, r_.size()) = r_;
+    if (jacobians != nullptr && jacobians[0] != nullptr)
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(jacobians[0], J_.rows(), J_.cols()) = J_;
     return true;
   }
 
  private:
   detail::FitEvaluator& e_;
+  mutable bool kept_ = false;
+  mutable VectorXd theta_, r_;
+  mutable MatrixXd J_;
 };
 
 class StopCallback final : public ceres::IterationCallback {
