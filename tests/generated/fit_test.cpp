@@ -323,6 +323,33 @@ std::string error_of(const std::function<void()>& f) {
   return "(no error)";
 }
 
+// A parameter the data do not depend on, fitted alone: its column of J holds only the response's
+// rounding (no other column to judge it against), so the analysis finds a standard deviation far
+// beyond any factor (1.9e5 in ln p) and says it is not identified; its standard error is that
+// large, and its profile is flat within the bounds (no 95 % bound: NaN, not the grid's last value).
+TEST(Fit, AParameterWithoutEffectAloneIsSaid) {
+  GeneratedModel m(middle_ear_sensitivity::kernels());
+  const auto hz = log_hz(200, 8000, 20);
+  MeasuredData data;
+  std::mt19937_64 rng(3);
+  data.responses.push_back(noisy(response(middle_ear_sensitivity::kernels(), {}, "P", "v_stapes", hz), hz, "P", "v_stapes", 0.01, rng));
+  mbsgen::FitOptions o;
+  o.profile = {"kr_al_z"};
+  const FitResult f = mbsgen::fit(m, data, around(m, {"kr_al_z"}, 10.0), o);
+  ASSERT_EQ(f.fisher.size(), 1u);
+  EXPECT_EQ(f.fisher[0].verdict, "not identified");
+  EXPECT_GT(f.fisher[0].sigma, 1e3);
+  EXPECT_EQ(f.fisher[0].description.rfind("kr_al_z is not identified (", 0), 0u) << f.fisher[0].description;
+  EXPECT_GT(f.standard_error[0] / f.values[0], 1e3);
+  EXPECT_TRUE(std::isnan(f.profiles[0].lower) && std::isnan(f.profiles[0].upper));  // a flat profile: no bound
+  EXPECT_THROW(mbsgen::fit(m, data, around(m, {"kr_al_z"}, 10.0), [] {
+                 mbsgen::FitOptions p;
+                 p.profile = {"k_al_z"};  // not fitted: refused before the work
+                 return p;
+               }()),
+               mbsgen::NameError);
+}
+
 TEST(Fit, BadProblemsAreRefusedWithClearMessages) {
   GeneratedModel m(chain3_sympy::kernels());
   const auto hz = log_hz(0.2, 10, 10);
@@ -355,6 +382,10 @@ TEST(Fit, DataFilesAreCheckedWithTheirLineAndColumn) {
   EXPECT_NE(err("frequency_hz,amplitude\n1,2\n").find("d.csv:1:14: unknown column 'amplitude'"), std::string::npos);
   EXPECT_EQ(err("frequency_hz,magnitude\n1,2,3\n"), "d.csv:2:1: 3 fields where the header names 2");
   EXPECT_EQ(err("# only a comment\n"), "d.csv:1:1: no header row (e.g. frequency_hz,magnitude,phase_deg)");
+  EXPECT_EQ(err("mode,frequency_hz,sigma_magnitude\n1,2,0.1\n"),
+            "d.csv:1:1: modal data (a 'mode' column) with a frequency-response column 'sigma_magnitude'");
+  // A spreadsheet's byte order mark before the header is skipped.
+  EXPECT_EQ(mbsgen::read_measured_data("\xEF\xBB\xBF" "frequency_hz,magnitude\n1,2\n", "d.csv", "F", "z").responses.size(), 1u);
   const MeasuredData d = mbsgen::read_measured_data(
       "# c\nfrequency_hz,magnitude_db,phase_deg,output\n10,20,-90,v\n20,0,,v\n", "d.csv", "F", "");
   ASSERT_EQ(d.responses.size(), 1u);

@@ -175,22 +175,32 @@ std::vector<Solution> solve_all(const GeneratedModel& model, const MeasuredData&
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t threads = std::min<std::size_t>(starts.size(), o.threads > 0 ? static_cast<unsigned>(o.threads) : hw);
   std::atomic<std::size_t> next{0};
+  std::atomic<bool> halt{false};  // set by the first failure: the other threads stop at their next step
+  FitOptions own = o;
+  own.stop = [&halt, &o] { return halt.load() || (o.stop && o.stop()); };
   std::exception_ptr failure;
   std::mutex m;
   const auto work = [&] {
     try {
       detail::FitEvaluator e(model, data, params);
-      for (std::size_t i; (i = next++) < starts.size();) out[i] = solve(e, starts[i], -1, o);
+      for (std::size_t i; (i = next++) < starts.size();) out[i] = solve(e, starts[i], -1, own);
     } catch (...) {
       const std::lock_guard<std::mutex> lock(m);
       if (!failure) failure = std::current_exception();
       next = starts.size();
+      halt = true;
     }
   };
   // The calling thread works too: a stop callback that only answers on the main thread (Python's
   // signal check) is asked there.
   std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  try {
+    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  } catch (...) {  // no thread to be had: those started are stopped and joined
+    halt = true;
+    for (auto& t : pool) t.join();
+    throw;
+  }
   work();
   for (auto& t : pool) t.join();
   if (failure) std::rethrow_exception(failure);
@@ -287,20 +297,31 @@ std::string spread_text(double sigma) {
 
 // What a direction v of the parameters (ln p, or p/|p̂|) with standard deviation σ means: for a
 // poorly determined one, "a and b are identified only as their ratio a/b" and the like.
-std::string describe_direction(const std::vector<std::string>& names, const VectorXd& v, double sigma,
-                               const std::string& verdict) {
+std::string describe_direction(const detail::FitEvaluator& e, const VectorXd& v, double sigma, const std::string& verdict) {
+  const std::vector<std::string>& names = e.names();
   std::vector<int> big;
   for (int j = 0; j < v.size(); ++j)
     if (std::abs(v[j]) >= 0.3) big.push_back(j);
+  if (big.empty()) {  // spread over many parameters, none above 0.3: the largest three name it
+    std::vector<int> all(static_cast<std::size_t>(v.size()));
+    for (int j = 0; j < v.size(); ++j) all[static_cast<std::size_t>(j)] = j;
+    std::sort(all.begin(), all.end(), [&](int a, int b) { return std::abs(v[a]) > std::abs(v[b]); });
+    big.assign(all.begin(), all.begin() + std::min<std::ptrdiff_t>(3, static_cast<std::ptrdiff_t>(all.size())));
+  }
   std::sort(big.begin(), big.end(), [&](int a, int b) { return std::abs(v[a]) > std::abs(v[b]); });
   const std::string spread = spread_text(sigma);
   const bool weak = verdict != "identified";
+  // A log-space parameter's coordinate is ln p; a linear one's p/|p̂| (fisher_analysis).
+  const auto coordinate = [&](int j) {
+    const std::string& n = names[static_cast<std::size_t>(j)];
+    return e.log_space(j) ? "ln " + n : n + "/|" + n + "|";
+  };
   std::ostringstream s;
   s.precision(2);
   const double rest = v.squaredNorm() - (big.size() >= 2 ? v[big[0]] * v[big[0]] + v[big[1]] * v[big[1]] : 0.0);
   if (big.size() == 1 || std::abs(v[big[0]]) > 0.9) {
     s << names[static_cast<std::size_t>(big[0])] << " is " << verdict << " (" << spread << ")";
-  } else if (weak && big.size() == 2 && rest < 0.1) {
+  } else if (weak && big.size() == 2 && rest < 0.1 && e.log_space(big[0]) && e.log_space(big[1])) {
     // Along v = (1, 1)/√2 both grow by the same factor: only a/b is fixed; along (1, −1), only a·b.
     const std::string& a = names[static_cast<std::size_t>(big[0])];
     const std::string& b = names[static_cast<std::size_t>(big[1])];
@@ -311,8 +332,8 @@ std::string describe_direction(const std::vector<std::string>& names, const Vect
   } else {
     s << "the combination";
     for (std::size_t k = 0; k < big.size(); ++k)
-      s << (k == 0 ? (v[big[k]] < 0 ? " −" : " ") : (v[big[k]] < 0 ? " − " : " + ")) << std::abs(v[big[k]]) << "·ln "
-        << names[static_cast<std::size_t>(big[k])];
+      s << (k == 0 ? (v[big[k]] < 0 ? " −" : " ") : (v[big[k]] < 0 ? " − " : " + ")) << std::abs(v[big[k]]) << "·"
+        << coordinate(big[k]);
     s << " is " << verdict << " (" << spread << ")";
   }
   return s.str();
@@ -343,9 +364,10 @@ std::vector<FisherDirection> fisher_analysis(const detail::FitEvaluator& e, cons
     d.sigma = kInf;
     d.direction = VectorXd::Unit(n, j);
     d.verdict = "not identified";
-    d.description = describe_direction(e.names(), d.direction, d.sigma, d.verdict);
+    d.description = describe_direction(e, d.direction, d.sigma, d.verdict);
     out.push_back(std::move(d));
   }
+  if (live.empty()) return out;  // no fitted parameter reaches the data
   MatrixXd Jl(Jr.rows(), static_cast<Eigen::Index>(live.size()));
   for (std::size_t k = 0; k < live.size(); ++k) Jl.col(static_cast<Eigen::Index>(k)) = Jr.col(live[k]);
   const MatrixXd F = Jl.transpose() * Jl / s2;
@@ -363,7 +385,7 @@ std::vector<FisherDirection> fisher_analysis(const detail::FitEvaluator& e, cons
     d.direction.cwiseAbs().maxCoeff(&big);
     if (d.direction[big] < 0) d.direction = -d.direction;
     d.verdict = d.sigma <= 0.1 ? "identified" : d.sigma <= 1.0 ? "weakly identified" : "not identified";
-    d.description = zero ? "" : describe_direction(e.names(), d.direction, d.sigma, d.verdict);
+    d.description = zero ? "" : describe_direction(e, d.direction, d.sigma, d.verdict);
     out.push_back(std::move(d));
   }
   // The directions with a zero eigenvalue span a space whose basis any rotation gives as well:
@@ -477,6 +499,7 @@ Profile profile(detail::FitEvaluator& e, const FitResult& f, const VectorXd& the
   p.lower = p.upper = kNaN;
   for (int i = mid; i > 0; --i) {
     const double a = delta(pts[static_cast<std::size_t>(i)]), b = delta(pts[static_cast<std::size_t>(i - 1)]);
+    if (!std::isfinite(b)) break;  // a point the model refused: no bound from beyond it
     if (a < chi && b >= chi) {
       const double w = (chi - a) / (b - a);
       p.lower = pts[static_cast<std::size_t>(i)].value + w * (pts[static_cast<std::size_t>(i - 1)].value - pts[static_cast<std::size_t>(i)].value);
@@ -485,6 +508,7 @@ Profile profile(detail::FitEvaluator& e, const FitResult& f, const VectorXd& the
   }
   for (int i = mid; i + 1 < m; ++i) {
     const double a = delta(pts[static_cast<std::size_t>(i)]), b = delta(pts[static_cast<std::size_t>(i + 1)]);
+    if (!std::isfinite(b)) break;
     if (a < chi && b >= chi) {
       const double w = (chi - a) / (b - a);
       p.upper = pts[static_cast<std::size_t>(i)].value + w * (pts[static_cast<std::size_t>(i + 1)].value - pts[static_cast<std::size_t>(i)].value);
@@ -520,7 +544,12 @@ void collect_warnings(const detail::FitEvaluator& e, const VectorXd& theta, FitR
     f.warnings.push_back(std::to_string(unidentified) + " of " + std::to_string(f.fisher.size()) +
                          " directions of the parameters are not identified by the data (one standard deviation above a "
                          "factor e; the identifiability analysis names them): their estimates rest on the start" +
-                         std::string(f.fisher.size() && unidentified ? " or the priors" : ""));
+                         std::string(e.rows() > e.data_rows() ? " or the priors" : ""));
+  if (!std::isfinite(f.residual_variance))
+    f.warnings.push_back("the data carry no standard deviations and leave no degree of freedom (" +
+                         std::to_string(f.residuals) + " residuals, " + std::to_string(e.cols()) +
+                         " parameters): their variance, and so the standard errors, cannot be estimated; give "
+                         "sigma_magnitude and sigma_phase_deg");
   if (f.minima.size() > 1)
     f.warnings.push_back(std::to_string(f.minima.size()) + " distinct local minima among the starts (the best reported)");
   for (const Profile& p : f.profiles)
@@ -542,6 +571,9 @@ FitResult fit(const GeneratedModel& model, const MeasuredData& data, const std::
   FitResult f;
   f.names = e.names();
   for (int j = 0; j < e.cols(); ++j) f.log_space.push_back(e.log_space(j));
+  for (const std::string& name : options.profile)  // before the work, not after it
+    if (std::find(f.names.begin(), f.names.end(), name) == f.names.end())
+      throw NameError("fit: --profile '" + name + "' is not a fitted parameter");
   const VectorXd theta0 = e.theta_of(e.start());
   f.start = e.start();
   f.residuals = e.data_rows();
@@ -577,7 +609,6 @@ FitResult fit(const GeneratedModel& model, const MeasuredData& data, const std::
                              std::isfinite(f.residual_variance) && f.residual_variance > 0 ? f.residual_variance : 1.0);
   for (const std::string& name : options.profile) {
     const auto it = std::find(f.names.begin(), f.names.end(), name);
-    if (it == f.names.end()) throw NameError("fit: --profile '" + name + "' is not a fitted parameter");
     f.profiles.push_back(profile(e, f, theta, static_cast<int>(it - f.names.begin()), options));
   }
   f.points = e.points(theta0, theta);

@@ -107,7 +107,8 @@ Columns read_header(const std::string& line, const std::string& origin, int numb
   };
   need(cols.count("frequency_hz") || cols.count("damping_ratio"), "the header names no frequency_hz column");
   if (modal) {
-    for (const char* c : {"re", "im", "magnitude", "magnitude_db", "phase_deg", "input", "output"})
+    for (const char* c : {"re", "im", "magnitude", "magnitude_db", "phase_deg", "input", "output", "sigma_magnitude",
+                          "sigma_phase_deg"})
       need(!cols.count(c), std::string("modal data (a 'mode' column) with a frequency-response column '") + c + "'");
   } else {
     need(cols.count("frequency_hz") > 0, "the header names no frequency_hz column");
@@ -143,6 +144,7 @@ MeasuredData read_measured_data(const std::string& text, const std::string& orig
   std::map<std::string, std::size_t> frf_index, modal_index;  // by set/input/output
   while (std::getline(in, line)) {
     ++number;
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte order mark (spreadsheets)
     const std::string t = trim(line);
     if (t.empty() || t[0] == '#') continue;
     if (!header) {

@@ -352,6 +352,8 @@ template <int S, int K, class... A>
 int along_forward_mode(int count, const int* which, A... a) {
   void* argv[] = {const_cast<void*>(static_cast<const void*>(a))...};
   const TapeModel::Impl* t = g_slots[S].load(std::memory_order_acquire);
+  for (int j = 0; j < count; ++j)
+    if (which[j] < 0 || static_cast<std::size_t>(which[j]) >= t->parameters.size()) return 1;  // no such parameter
   const std::vector<double> e = t->directions(count, which);
   return K == kSensitivity ? t->sensitivity_by_forward_mode(argv, e) : t->operating_point_sensitivity_by_forward_mode(argv, e);
 }
