@@ -82,7 +82,9 @@ TEST(FitCommand, WritesItsFilesAllOrNothingAndNeverAForeignOne) {
   Result r = run(args, d.dir, d.env);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(r.output.rfind("{\"generator\": \"mbsgen fit\"", 0), 0u) << r.output;
-  for (const char* f : {"fit.json", "fit_points.csv", "fit_profile_k1.csv"}) EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
+  for (const char* f : {"fit.json", "fit_points.csv", "fit_estimates.csv", "fit_profile_k1.csv"})
+    EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
+  EXPECT_NE(slurp(out / "fit_estimates.csv").find("\n\"k1\",log,10,"), std::string::npos) << slurp(out / "fit_estimates.csv");
   EXPECT_NE(slurp(out / "fit_points.csv").find("data.csv\","), std::string::npos);
   EXPECT_NE(slurp(d.dir / "fit.svg").find("<svg"), std::string::npos);
   r = run(args, d.dir, d.env);  // its own files: replaced

@@ -128,6 +128,30 @@ std::string points_csv(const ModelKernels& k, const FitResult& f) {
   return s.str();
 }
 
+// The estimates, and the identifiability directions, as CSV (JSON has them too).
+std::string estimates_csv(const ModelKernels& k, const FitResult& f) {
+  std::ostringstream s;
+  s << "# " << kMarker << ": model " << csv_field(k.model) << ", the estimates (" << (f.converged ? "converged" : "NOT CONVERGED")
+    << ", cost " << num(f.cost, false) << ") and 95 % intervals; correlations in fit.json\n"
+    << "parameter,space,start,estimate,standard_error,lower95,upper95,at_bound\n";
+  for (std::size_t j = 0; j < f.names.size(); ++j) {
+    const auto i = static_cast<Eigen::Index>(j);
+    s << csv_field(f.names[j]) << "," << (f.log_space[j] ? "log" : "linear") << "," << num(f.start[i], false) << ","
+      << num(f.values[i], false) << "," << num(f.standard_error[i], false) << "," << num(f.lower95[i], false) << ","
+      << num(f.upper95[i], false) << "," << f.at_bound[j] << "\n";
+  }
+  s << "\n# identifiability: directions of the Fisher information (relative coordinates), weakest first\n"
+    << "eigenvalue,sigma,verdict,description";
+  for (const std::string& n : f.names) s << "," << csv_field("v_" + n);
+  s << "\n";
+  for (const FisherDirection& d : f.fisher) {
+    s << num(d.eigenvalue, false) << "," << num(d.sigma, false) << "," << csv_field(d.verdict) << "," << csv_field(d.description);
+    for (Eigen::Index i = 0; i < d.direction.size(); ++i) s << "," << num(d.direction[i], false);
+    s << "\n";
+  }
+  return s.str();
+}
+
 // The plot: per input/output pair the model at the start and at the fit on 200 frequencies over
 // its data's range, and per data set its points with their residuals.
 void plot_fit(const std::string& path, const GeneratedModel& model0, const FitResult& f, const MeasuredData& data,
@@ -202,7 +226,8 @@ CLI::App* add_fit(CLI::App& app, FitCliOptions& o) {
   fit->add_option("--profile-points", o.profile_points, "points of each profile")->check(CLI::Range(3, 1001));
   fit->add_flag("--no-fit", o.no_fit, "no optimization: the statistics and identifiability at the start");
   fit->add_option("--format", o.format, "output format")->check(CLI::IsMember({"table", "json"}));
-  fit->add_option("--out", o.out_dir, "write fit.json and fit_points.csv (and fit_profile_NAME.csv) into this directory");
+  fit->add_option("--out", o.out_dir,
+                  "write fit.json, fit_estimates.csv, fit_points.csv (and fit_profile_NAME.csv) into this directory");
   fit->add_option("--plot", o.plot, "write data, start and fit with the residuals (FILE.svg or FILE.png)");
   return fit;
 }
@@ -232,6 +257,7 @@ FitInputs prepare(const FitCliOptions& o, GeneratedModel& model, bool writes) {
   if (!o.out_dir.empty()) {
     in.files.push_back({std::filesystem::path(o.out_dir) / "fit.json", ""});
     in.files.push_back({std::filesystem::path(o.out_dir) / "fit_points.csv", ""});
+    in.files.push_back({std::filesystem::path(o.out_dir) / "fit_estimates.csv", ""});
     for (const std::string& name : o.profile)
       in.files.push_back({std::filesystem::path(o.out_dir) / ("fit_profile_" + name + ".csv"), ""});
   }
@@ -255,6 +281,7 @@ void write_outputs(const ModelKernels& k, const FitCliOptions& o, const Generate
   if (!in.files.empty()) {
     in.files[0].content = json_result(k, f);
     in.files[1].content = points_csv(k, f);
+    in.files[2].content = estimates_csv(k, f);
     for (std::size_t q = 0; q < f.profiles.size(); ++q) {
       std::ostringstream s;
       s << "# " << kMarker << ": model " << csv_field(k.model) << ", profile likelihood of " << f.profiles[q].parameter
@@ -262,7 +289,7 @@ void write_outputs(const ModelKernels& k, const FitCliOptions& o, const Generate
         << f.profiles[q].parameter << ",cost,converged\n";
       for (const ProfilePoint& p : f.profiles[q].points)
         s << num(p.value, false) << "," << num(p.cost, false) << "," << (p.converged ? 1 : 0) << "\n";
-      in.files[2 + q].content = s.str();
+      in.files[3 + q].content = s.str();
     }
     write_all_or_nothing(in.files, kMarker, "fit");
   }
