@@ -268,18 +268,19 @@ ResponseSensitivity Model::frf_sensitivity(const ConstVectorRef& p, const std::s
   const Eigen::Index in = model.input_index(input), out = model.output_index(output);
   const mbsgen::OperatingPoint op = model.operating_point();
   const LinearModel lin = model.linear_model(op);
-  const std::vector<MatrixSensitivity> d = model.linear_sensitivities(op, names);
-  const FrequencyResponseSensitivity s =
-      frequency_response_sensitivity(lin, d, std::vector<double>(hz.data(), hz.data() + hz.size()));
+  std::vector<MatrixSensitivity> d = model.linear_sensitivities(op, names);
+  for (MatrixSensitivity& x : d) x = select(x, {in}, {out});  // the one pair asked for, as the CLI
+  const FrequencyResponseSensitivity s = frequency_response_sensitivity(
+      lin.select({in}, {out}), d, std::vector<double>(hz.data(), hz.data() + hz.size()));
   ResponseSensitivity r;
   const Eigen::Index f = hz.size(), q = static_cast<Eigen::Index>(d.size());
   r.values.resize(f);
   r.rcond = Eigen::Map<const Vector>(s.rcond.data(), static_cast<Eigen::Index>(s.rcond.size()));
   r.derivatives.resize(q, f);
   for (Eigen::Index i = 0; i < f; ++i) {
-    r.values[i] = s.response[static_cast<std::size_t>(i)](out, in);
+    r.values[i] = s.response[static_cast<std::size_t>(i)](0, 0);
     for (Eigen::Index j = 0; j < q; ++j)
-      r.derivatives(j, i) = s.derivative[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)](out, in);
+      r.derivatives(j, i) = s.derivative[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)](0, 0);
   }
   r.parameter_values.resize(q);
   for (Eigen::Index j = 0; j < q; ++j) {

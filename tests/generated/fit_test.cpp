@@ -117,6 +117,16 @@ double truth_of(const std::vector<std::pair<std::string, double>>& t, const std:
   return NAN;
 }
 
+// The chain's end_x/F at hz for the parameters `truth` (the model's values: {}), with noise (as
+// noisy()) from the seed.
+MeasuredData chain_data(const std::vector<std::pair<std::string, double>>& truth, const std::vector<double>& hz,
+                        double noise, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  MeasuredData data;
+  data.responses.push_back(noisy(response(chain3_sympy::kernels(), truth, "F", "end_x", hz), hz, "F", "end_x", noise, rng));
+  return data;
+}
+
 // ---------------------------------------------------------------------------------------------
 // The Jacobian: d ln H/dθ_j = (dH/dp_j / H) p_j, with dH/dp_j by 80-digit central differences
 // along the matrices' derivatives (hp::frf_derivative; the derivatives of M, Q, K, B, C from the
@@ -170,9 +180,7 @@ TEST(Fit, MiddleEarJacobianAgainstHighPrecision) {
 TEST(Fit, ChainNoiseFreeRecoversTheTruthExactly) {
   GeneratedModel m(chain3_sympy::kernels());
   const auto hz = log_hz(0.2, 10, 40);
-  MeasuredData data;
-  std::mt19937_64 rng(1);
-  data.responses.push_back(noisy(response(chain3_sympy::kernels(), kChainTruth, "F", "end_x", hz), hz, "F", "end_x", 0.0, rng));
+  const MeasuredData data = chain_data(kChainTruth, hz, 0.0, 1);
   const FitResult f = mbsgen::fit(m, data, around(m, kChainNames, 10.0));
   ASSERT_TRUE(f.converged) << f.termination;
   for (std::size_t j = 0; j < kChainNames.size(); ++j)
@@ -353,9 +361,7 @@ TEST(Fit, AParameterWithoutEffectAloneIsSaid) {
 TEST(Fit, BadProblemsAreRefusedWithClearMessages) {
   GeneratedModel m(chain3_sympy::kernels());
   const auto hz = log_hz(0.2, 10, 10);
-  MeasuredData data;
-  std::mt19937_64 rng(1);
-  data.responses.push_back(noisy(response(chain3_sympy::kernels(), {}, "F", "end_x", hz), hz, "F", "end_x", 0.01, rng));
+  const MeasuredData data = chain_data({}, hz, 0.01, 1);
   auto params = around(m, {"k1"}, 2.0);
   params[0].name = "k9";
   EXPECT_NE(error_of([&] { mbsgen::fit(m, data, params); }).find("unknown parameter 'k9'"), std::string::npos);
@@ -399,9 +405,7 @@ TEST(Fit, DataFilesAreCheckedWithTheirLineAndColumn) {
 TEST(Fit, NotConvergedAndOnABoundAreSaid) {
   GeneratedModel m(chain3_sympy::kernels());
   const auto hz = log_hz(0.2, 10, 30);
-  MeasuredData data;
-  std::mt19937_64 rng(1);
-  data.responses.push_back(noisy(response(chain3_sympy::kernels(), kChainTruth, "F", "end_x", hz), hz, "F", "end_x", 0.0, rng));
+  const MeasuredData data = chain_data(kChainTruth, hz, 0.0, 1);
   mbsgen::FitOptions o;
   o.max_iterations = 1;
   const FitResult f = mbsgen::fit(m, data, around(m, kChainNames, 10.0), o);
@@ -425,9 +429,7 @@ TEST(Fit, NotConvergedAndOnABoundAreSaid) {
 TEST(Fit, ProfileMatchesTheIntervalWhereTheCostIsQuadratic) {
   GeneratedModel m(chain3_sympy::kernels());
   const auto hz = log_hz(0.2, 10, 60);
-  MeasuredData data;
-  std::mt19937_64 rng(9);
-  data.responses.push_back(noisy(response(chain3_sympy::kernels(), kChainTruth, "F", "end_x", hz), hz, "F", "end_x", 0.01, rng));
+  const MeasuredData data = chain_data(kChainTruth, hz, 0.01, 9);
   mbsgen::FitOptions o;
   o.profile = {"k1"};
   o.profile_points = 41;
@@ -447,9 +449,7 @@ TEST(Fit, ProfileMatchesTheIntervalWhereTheCostIsQuadratic) {
 TEST(Fit, MultiStartOnThreads) {
   GeneratedModel m(chain3_sympy::kernels());
   const auto hz = log_hz(0.2, 10, 40);
-  MeasuredData data;
-  std::mt19937_64 rng(2);
-  data.responses.push_back(noisy(response(chain3_sympy::kernels(), kChainTruth, "F", "end_x", hz), hz, "F", "end_x", 0.01, rng));
+  const MeasuredData data = chain_data(kChainTruth, hz, 0.01, 2);
   mbsgen::FitOptions o;
   o.starts = 8;
   o.threads = 2;

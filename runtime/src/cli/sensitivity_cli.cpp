@@ -87,9 +87,11 @@ void write_frf_sensitivity(std::ostream& out, const GeneratedModel& model, Eigen
                            const std::string& format) {
   const OperatingPoint op = model.operating_point();
   const LinearModel lin = model.linear_model(op);
-  const std::vector<MatrixSensitivity> d = model.linear_sensitivities(op, parameters);
-  const FrequencyResponseSensitivity r =
-      frequency_response_sensitivity(lin, d, std::vector<double>(hz.data(), hz.data() + hz.size()));
+  // The one input and output asked for (LinearModel::select): one right-hand side per frequency.
+  std::vector<MatrixSensitivity> d = model.linear_sensitivities(op, parameters);
+  for (MatrixSensitivity& x : d) x = select(x, {input}, {output});
+  const FrequencyResponseSensitivity r = frequency_response_sensitivity(
+      lin.select({input}, {output}), d, std::vector<double>(hz.data(), hz.data() + hz.size()));
   const bool json = format == "json";
   if (json) {
     out << "{\"model\": " << json_string(model.kernels().model) << ", \"input\": "
@@ -112,7 +114,7 @@ void write_frf_sensitivity(std::ostream& out, const GeneratedModel& model, Eigen
     out << "\n";
   }
   for (std::size_t i = 0; i < r.frequencies_hz.size(); ++i) {
-    const std::complex<double> z = r.response[i](output, input);
+    const std::complex<double> z = r.response[i](0, 0);
     if (json) out << (i ? "," : "") << "\n  {\"frequency_hz\": " << num(hz[static_cast<Eigen::Index>(i)], true)
                   << ", \"response\": [" << num(z.real(), true) << ", " << num(z.imag(), true) << "], \"sensitivities\": [";
     else if (format == "csv")
@@ -121,7 +123,7 @@ void write_frf_sensitivity(std::ostream& out, const GeneratedModel& model, Eigen
     else
       out << pad(short_num(hz[static_cast<Eigen::Index>(i)]), 14) << pad(short_num(std::abs(z)), 14);
     for (std::size_t j = 0; j < d.size(); ++j) {
-      const std::complex<double> dz = r.derivative[j][i](output, input);
+      const std::complex<double> dz = r.derivative[j][i](0, 0);
       const std::complex<double> rel = d[j].value * dz / z;  // NaN where z = 0
       if (json)
         out << (j ? ", " : "") << "{\"dlnmag_dlnp\": " << num(rel.real(), true) << ", \"dphase_dlnp\": "

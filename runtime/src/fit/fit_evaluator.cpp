@@ -20,40 +20,6 @@ std::string number_text(double x) {
   return b;
 }
 
-// The rows and columns of a matrix (0×0: zero, kept so).
-Eigen::MatrixXd pick(const Eigen::MatrixXd& a, const std::vector<Eigen::Index>* rows, const std::vector<Eigen::Index>* cols) {
-  if (a.size() == 0) return a;
-  const Eigen::Index r = rows ? static_cast<Eigen::Index>(rows->size()) : a.rows();
-  const Eigen::Index c = cols ? static_cast<Eigen::Index>(cols->size()) : a.cols();
-  Eigen::MatrixXd out(r, c);
-  for (Eigen::Index j = 0; j < c; ++j)
-    for (Eigen::Index i = 0; i < r; ++i)
-      out(i, j) = a(rows ? (*rows)[static_cast<std::size_t>(i)] : i, cols ? (*cols)[static_cast<std::size_t>(j)] : j);
-  return out;
-}
-
-// The linear model with only the data's inputs and outputs: a response's solves then carry one
-// right-hand side per measured input, not per input of the model (the middle ear has seven).
-LinearModel restrict(const LinearModel& m, const std::vector<Eigen::Index>& in, const std::vector<Eigen::Index>& out) {
-  return LinearModel(m.M(), m.Q(), m.K(), pick(m.B(), nullptr, &in), pick(m.C_y(), &out, nullptr),
-                     pick(m.C_v(), &out, nullptr))
-      .with_output_terms(pick(m.C_a(), &out, nullptr), pick(m.D(), &out, &in))
-      .with_input_rates(pick(m.B1(), nullptr, &in), pick(m.B2(), nullptr, &in), pick(m.D1(), &out, &in));
-}
-
-MatrixSensitivity restrict(const MatrixSensitivity& d, const std::vector<Eigen::Index>& in, const std::vector<Eigen::Index>& out) {
-  MatrixSensitivity r = d;
-  r.B = pick(d.B, nullptr, &in);
-  r.C_y = pick(d.C_y, &out, nullptr);
-  r.C_v = pick(d.C_v, &out, nullptr);
-  r.C_a = pick(d.C_a, &out, nullptr);
-  r.D = pick(d.D, &out, &in);
-  r.B1 = pick(d.B1, nullptr, &in);
-  r.B2 = pick(d.B2, nullptr, &in);
-  r.D1 = pick(d.D1, &out, &in);
-  return r;
-}
-
 // Whether point i of d has a magnitude (data without the column has_magnitude: every point).
 bool magnitude(const FrfData& d, std::size_t i) { return d.has_magnitude.size() <= i || d.has_magnitude[i]; }
 
@@ -177,8 +143,9 @@ void FitEvaluator::compute(const Eigen::VectorXd& theta, bool jacobian, Response
   Eigen::Index row = 0;
   if (!data_.responses.empty()) {
     std::vector<MatrixSensitivity> dr;
-    for (const MatrixSensitivity& x : d) dr.push_back(restrict(x, inputs_, outputs_));
-    const FrequencyResponseSensitivity s = frequency_response_sensitivity(restrict(lin, inputs_, outputs_), dr, hz_);
+    for (const MatrixSensitivity& x : d) dr.push_back(select(x, inputs_, outputs_));
+    // Only the data's inputs and outputs: one right-hand side per measured input.
+    const FrequencyResponseSensitivity s = frequency_response_sensitivity(lin.select(inputs_, outputs_), dr, hz_);
     for (std::size_t k = 0; k < data_.responses.size(); ++k)
       for (std::size_t i = 0; i < at_[k].size(); ++i, ++row) {
         const std::size_t f = at_[k][i];

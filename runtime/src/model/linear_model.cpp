@@ -155,6 +155,58 @@ LinearModel LinearModel::with_input_rates(Eigen::MatrixXd B1, Eigen::MatrixXd B2
   return copy;
 }
 
+namespace {
+
+// The rows and columns of a (all of one kind when its list is null); 0×0 (zero) stays 0×0.
+Eigen::MatrixXd pick(const Eigen::MatrixXd& a, const std::vector<Eigen::Index>* rows, const std::vector<Eigen::Index>* cols) {
+  if (a.size() == 0) return a;
+  const Eigen::Index r = rows ? static_cast<Eigen::Index>(rows->size()) : a.rows();
+  const Eigen::Index c = cols ? static_cast<Eigen::Index>(cols->size()) : a.cols();
+  Eigen::MatrixXd out(r, c);
+  for (Eigen::Index j = 0; j < c; ++j)
+    for (Eigen::Index i = 0; i < r; ++i)
+      out(i, j) = a(rows ? (*rows)[static_cast<std::size_t>(i)] : i, cols ? (*cols)[static_cast<std::size_t>(j)] : j);
+  return out;
+}
+
+std::vector<std::string> pick(const std::vector<std::string>& names, const std::vector<Eigen::Index>& which) {
+  std::vector<std::string> out;
+  if (names.empty()) return out;
+  for (Eigen::Index i : which) out.push_back(names[static_cast<std::size_t>(i)]);
+  return out;
+}
+
+void check_indices(const std::vector<Eigen::Index>& which, Eigen::Index n, const char* what) {
+  for (Eigen::Index i : which)
+    if (i < 0 || i >= n)
+      throw DimensionError(std::string("LinearModel::select: ") + what + " " + std::to_string(i) + " of " + std::to_string(n));
+}
+
+}  // namespace
+
+LinearModel LinearModel::select(const std::vector<Eigen::Index>& in, const std::vector<Eigen::Index>& out) const {
+  check_indices(in, num_inputs(), "input");
+  check_indices(out, num_outputs(), "output");
+  return LinearModel(M_, Q_, K_, pick(B_, nullptr, &in), pick(C_y_, &out, nullptr), pick(C_v_, &out, nullptr),
+                     coordinate_names_, pick(input_names_, in), pick(output_names_, out), coordinate_units_,
+                     pick(input_units_, in), pick(output_units_, out))
+      .with_output_terms(pick(C_a_, &out, nullptr), pick(D_, &out, &in))
+      .with_input_rates(pick(B1_, nullptr, &in), pick(B2_, nullptr, &in), pick(D1_, &out, &in));
+}
+
+MatrixSensitivity select(const MatrixSensitivity& d, const std::vector<Eigen::Index>& in, const std::vector<Eigen::Index>& out) {
+  MatrixSensitivity r = d;
+  r.B = pick(d.B, nullptr, &in);
+  r.C_y = pick(d.C_y, &out, nullptr);
+  r.C_v = pick(d.C_v, &out, nullptr);
+  r.C_a = pick(d.C_a, &out, nullptr);
+  r.D = pick(d.D, &out, &in);
+  r.B1 = pick(d.B1, nullptr, &in);
+  r.B2 = pick(d.B2, nullptr, &in);
+  r.D1 = pick(d.D1, &out, &in);
+  return r;
+}
+
 bool LinearModel::input_has_rates(Eigen::Index j) const {
   for (const Eigen::MatrixXd* A : {&B1_, &B2_, &D1_})
     if (A->size() != 0 && (A->col(j).array() != 0.0).any()) return true;

@@ -124,10 +124,11 @@ void combine(CM& out, Eigen::Index rows, Eigen::Index cols, const Part& x0, cons
   if (!x2.zero) out.real() -= (w * w) * x2.a;
 }
 
-// (x0 + iw x1 − w² x2) X for real x0, x1, x2 and complex X: real products, zero parts skipped.
-void apply(CM& out, const Part& x0, const Part& x1, const Part& x2, double w, const CM& X, Eigen::Index rows) {
-  out.setZero(rows, X.cols());
-  const Eigen::MatrixXd Xr = X.real(), Xi = X.imag();
+// (x0 + iw x1 − w² x2) X for real x0, x1, x2 and complex X = Xr + i Xi (its parts split once per
+// frequency by the caller): real products, zero parts skipped.
+void apply(CM& out, const Part& x0, const Part& x1, const Part& x2, double w, const Eigen::MatrixXd& Xr,
+           const Eigen::MatrixXd& Xi, Eigen::Index rows) {
+  out.setZero(rows, Xr.cols());
   const auto add = [&](const Part& x, Cx factor) {
     if (x.zero) return;
     const Eigen::MatrixXd re = x.a * Xr, im = x.a * Xi;
@@ -167,6 +168,7 @@ FrequencyResponseSensitivity frequency_response_sensitivity(const LinearModel& m
   const double u = std::numeric_limits<double>::epsilon();
   // Work space reused over the frequencies (each analysis used to allocate its temporaries anew).
   CM A, Bw, Cw, X, Z, W, dAX, dBw, dCw, dZ;
+  Eigen::MatrixXd Xr, Xi;
   Eigen::PartialPivLU<CM> lu(f);
   for (double hz : frequencies_hz) {
     if (!std::isfinite(hz)) throw NonFiniteError("frequency_response_sensitivity: frequency " + std::to_string(hz) + " Hz");
@@ -186,15 +188,17 @@ FrequencyResponseSensitivity frequency_response_sensitivity(const LinearModel& m
     out.response.push_back(Z);
     if (dP.empty()) continue;
     // dẑ = dC X + C(Ω) A⁻¹ (dB(Ω) − dA X) + dD.
+    Xr = X.real();
+    Xi = X.imag();
     for (std::size_t j = 0; j < dP.size(); ++j) {
       const Parts& d = dP[j];
-      apply(dAX, d.K, d.Q, d.M, w, X, f);
+      apply(dAX, d.K, d.Q, d.M, w, Xr, Xi, f);
       combine(dBw, f, m, d.B, d.B1, d.B2, w);
       dBw -= dAX;
       W = lu.solve(dBw);
       dZ.noalias() = Cw * W;
       if (!(d.Cy.zero && d.Cv.zero && d.Ca.zero)) {
-        apply(dCw, d.Cy, d.Cv, d.Ca, w, X, r);
+        apply(dCw, d.Cy, d.Cv, d.Ca, w, Xr, Xi, r);
         dZ += dCw;
       }
       if (!d.D.zero) dZ.real() += d.D.a;

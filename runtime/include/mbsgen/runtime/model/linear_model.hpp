@@ -83,6 +83,12 @@ class LinearModel {
   /// "LinearModel::with_input_rates", the matrix and its dimensions.
   LinearModel with_input_rates(Eigen::MatrixXd B1, Eigen::MatrixXd B2, Eigen::MatrixXd D1) const;
 
+  /// A copy with only the inputs `inputs` (columns of B, B1, B2, D, D1) and the outputs `outputs`
+  /// (rows of C_y, C_v, C_a, D, D1), in the order given, with their names and units: a response or
+  /// its derivatives then solve one right-hand side per chosen input, not per input of the model
+  /// (the middle ear has seven). DimensionError for an index out of range.
+  LinearModel select(const std::vector<Eigen::Index>& inputs, const std::vector<Eigen::Index>& outputs) const;
+
   bool has_damping() const { return has_Q_; }  ///< false when Q is exactly zero
   /// True when M and K are exactly symmetric and Q is exactly zero (fast path of the modes).
   bool is_symmetric_undamped() const;
@@ -115,5 +121,9 @@ struct MatrixSensitivity {
   Eigen::MatrixXd M, Q, K, B, C_y, C_v, C_a, D, B1, B2, D1;
   Eigen::VectorXd dy0, dyd0;  ///< the operating point's derivatives (zero when it does not move)
 };
+
+/// The derivative of LinearModel::select(inputs, outputs): the same columns and rows of d.
+MatrixSensitivity select(const MatrixSensitivity& d, const std::vector<Eigen::Index>& inputs,
+                         const std::vector<Eigen::Index>& outputs);
 
 }  // namespace mbsgen
