@@ -28,7 +28,8 @@ else
   packages=(cmake g++ make pkg-config libginac-dev libcln-dev libeigen3-dev libyaml-cpp-dev
             libcli11-dev libgtest-dev liblapacke-dev libopenblas-dev gnuplot-nox libjemalloc-dev
             libsundials-cvode6 libboost-dev libopenmpi-dev openmpi-bin
-            pybind11-dev python3-dev python3-numpy python3-pytest libceres3 libgoogle-glog-dev "$@")
+            pybind11-dev python3-dev python3-numpy python3-pytest libceres3 libgoogle-glog-dev
+            liburdfdom-dev "$@")
 fi
 missing=()
 for p in "${packages[@]}"; do

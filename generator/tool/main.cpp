@@ -6,6 +6,7 @@
 #include "mbsgen/generator/codegen/output_files.hpp"
 #include "mbsgen/generator/linear/operating_point_check.hpp"
 #include "mbsgen/generator/model/scene.hpp"
+#include "mbsgen/generator/model/urdf_import.hpp"
 #include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include <CLI/CLI.hpp>
@@ -17,9 +18,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -158,6 +161,84 @@ int run_command(int argc, char** argv) {
   }
 }
 
+// `mbsgen import FILE.urdf [--out MODEL.yaml] [options]`: the URDF as a model file (docs/urdf.md).
+struct ImportRequest {
+  std::string file, out, base = "fixed", elastic_text, pose_text, output_text;
+  std::vector<double> gravity{0, 0, -9.81};
+  double stiffness = 1e4, damping = 10;
+  bool no_inputs = false;
+};
+
+void add_import_options(CLI::App& app, ImportRequest& r) {
+  app.add_option("URDF", r.file, "the robot description (.urdf)")->required();
+  app.add_option("--out", r.out, "write the model here (all or nothing; never over a file mbsgen did not write); "
+                                 "default: standard output");
+  app.add_option("--base", r.base, "the root link fixed to the world (default, as URDF means it) or floating "
+                                   "(six coordinates)")
+      ->check(CLI::IsMember({"fixed", "floating"}));
+  app.add_option("--gravity", r.gravity, "gravity in the world frame, m/s^2 (default 0 0 -9.81)")->expected(3);
+  app.add_option("--elastic", r.elastic_text, "joints with a joint spring and damper (series elastic), comma-separated, "
+                                              "or all");
+  app.add_option("--stiffness", r.stiffness, "each elastic joint's stiffness, N m/rad or N/m (default 1e4)");
+  app.add_option("--damping", r.damping, "each elastic joint's damping, N m s/rad or N s/m (default 10)");
+  app.add_option("--output", r.output_text, "links whose origins' position and velocity are outputs, comma-separated "
+                                            "(default: the leaf links)");
+  app.add_option("--pose", r.pose_text, "joint values JOINT=VALUE,... of the pose: the operating point's guess and "
+                                        "the springs' rest (default 0)");
+  app.add_flag("--no-inputs", r.no_inputs, "no torque (force) inputs at the joints");
+}
+
+std::vector<std::string> split_commas(const std::string& s) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(s);
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+int import_command(const ImportRequest& r) {
+  mbsgen::UrdfImportOptions o;
+  o.floating_base = r.base == "floating";
+  for (int k = 0; k < 3; ++k) o.gravity[k] = r.gravity[k];
+  o.elastic = split_commas(r.elastic_text);
+  o.stiffness = r.stiffness;
+  o.damping = r.damping;
+  o.outputs = split_commas(r.output_text);
+  o.inputs = !r.no_inputs;
+  for (const auto& item : split_commas(r.pose_text)) {
+    const auto eq = item.find('=');
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      if (eq == std::string::npos) throw std::invalid_argument("");
+      v = std::stod(item.substr(eq + 1), &used);
+    } catch (const std::exception&) {
+      used = std::string::npos;
+    }
+    if (used != item.size() - eq - 1 || !std::isfinite(v)) {
+      std::cerr << "mbsgen import: --pose: '" << item << "' is not JOINT=VALUE\n";
+      return 2;
+    }
+    o.pose[item.substr(0, eq)] = v;
+  }
+  if (!(r.stiffness > 0) || !(r.damping >= 0) || !std::isfinite(r.stiffness) || !std::isfinite(r.damping)) {
+    std::cerr << "mbsgen import: --stiffness must be positive and --damping nonnegative (finite)\n";
+    return 2;
+  }
+  mbsgen::UrdfImport imported = mbsgen::import_urdf_file(r.file, o);
+  // What the import wrote must be a model: read it as `check` would, before a byte is written.
+  (void)mbsgen::read_model_string(imported.yaml, r.file + " (as imported)");
+  for (const auto& n : imported.notes) std::cerr << "mbsgen import: note: " << n << "\n";
+  if (r.out.empty()) {
+    std::cout << imported.yaml;
+    return 0;
+  }
+  mbsgen::write_files({{r.out, imported.yaml}});
+  std::cerr << "mbsgen import: wrote " << r.out << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) try {
@@ -174,12 +255,12 @@ int main(int argc, char** argv) try {
   std::size_t parts = 0;
   std::size_t part_operations = 5000;
   auto* check = app.add_subcommand("check", "read and validate a model file (and its operating point)");
-  check->add_option("MODEL", model_file, "model file (YAML)")->required();
+  check->add_option("MODEL", model_file, "model file (YAML, or a robot's .urdf)")->required();
   auto* info = app.add_subcommand("info", "scenes, effects, kernels and operation counts");
-  info->add_option("MODEL", model_file, "model file (YAML)")->required();
+  info->add_option("MODEL", model_file, "model file (YAML, or a robot's .urdf)")->required();
   info->add_option("--scene", scene, "scene to describe (default: the full model)");
   auto* generate = app.add_subcommand("generate", "emit C++ kernels and a JSON manifest");
-  generate->add_option("MODEL", model_file, "model file (YAML)")->required();
+  generate->add_option("MODEL", model_file, "model file (YAML, or a robot's .urdf)")->required();
   generate->add_option("--out", out_dir, "output directory")->required();
   generate->add_option("--scene", scene, "scene to generate (default: the full model)");
   generate->add_option("--id", id, "C identifier prefix of the kernels (default: the model name, "
@@ -205,11 +286,14 @@ int main(int argc, char** argv) try {
                        "operations per part of a long kernel, one longer than 4 times this (default 5000; 0: no kernel is cut, as before issue 17)")
       ->check(CLI::Range(std::size_t{0}, std::size_t{10000000}));
   auto* tape_cmd = app.add_subcommand("tape", "make sure a model's tape is cached (as mbsgen run makes it) and print its path");
-  tape_cmd->add_option("MODEL", model_file, "model file (YAML)")->required();
+  tape_cmd->add_option("MODEL", model_file, "model file (YAML, or a robot's .urdf)")->required();
   tape_cmd->add_option("--scene", scene, "scene (default: the full model)");
   auto* kernels_cmd = app.add_subcommand("kernels", "make sure a model's kernels are cached, compiled as a shared library, and print its path");
-  kernels_cmd->add_option("MODEL", model_file, "model file (YAML)")->required();
+  kernels_cmd->add_option("MODEL", model_file, "model file (YAML, or a robot's .urdf)")->required();
   kernels_cmd->add_option("--scene", scene, "scene (default: the full model)");
+  auto* import_cmd = app.add_subcommand("import", "a URDF robot description as an mbsgen model file (docs/urdf.md)");
+  ImportRequest import_request;
+  add_import_options(*import_cmd, import_request);
   app.add_subcommand("linear", "modes and frequency responses of raw matrices (mbsgen linear --help)");
   app.add_subcommand("run", "generate, compile, cache and run a model's solver (mbsgen run --help)");
   auto* cache = app.add_subcommand("cache", "list, describe or clean the cache of mbsgen run");
@@ -241,6 +325,17 @@ int main(int argc, char** argv) try {
       return 1;
     }
   }
+  if (*import_cmd) {
+    try {
+      return import_command(import_request);
+    } catch (const mbsgen::ModelError& e) {
+      std::cerr << e.what() << "\n";
+      return 1;
+    } catch (const std::exception& e) {
+      std::cerr << "mbsgen import: error: " << e.what() << "\n";
+      return 1;
+    }
+  }
   if (*cache) {
     if (*cache_info) return mbsgen::tool::cache_info();
     if (!*cache_clean) return mbsgen::tool::cache_list();
@@ -262,6 +357,8 @@ int main(int argc, char** argv) try {
   try {
     auto t0 = std::chrono::steady_clock::now();
     mbsgen::tool::Progress progress(*check ? "check" : *info ? "info" : "generate");
+    if ((*check || *info) && mbsgen::is_urdf_path(model_file))
+      for (const auto& n : mbsgen::import_urdf_file(model_file).notes) std::cerr << "mbsgen: note: " << n << "\n";
     mbsgen::Model model = mbsgen::read_model_file(model_file);
     mbsgen::Model pruned = mbsgen::apply_scene(model, scene);
     if (sensitivity || !sensitivity_parameters.empty()) pruned.request_sensitivity(sensitivity_parameters);

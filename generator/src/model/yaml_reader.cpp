@@ -1,6 +1,7 @@
 #include "mbsgen/generator/model/yaml_reader.hpp"
 
 #include "mbsgen/generator/model/escape.hpp"
+#include "mbsgen/generator/model/urdf_import.hpp"
 
 #include "model/expression_sites.hpp"
 #include "symbolic/checked_subs.hpp"
@@ -1736,6 +1737,11 @@ std::string read_model_text(const std::string& path) {
   return text;
 }
 
-Model read_model_file(const std::string& path) { return read_model_string(read_model_text(path), path); }
+Model read_model_file(const std::string& path) {
+  // A URDF file is imported with the default options (urdf_import.hpp); YAML errors in what the
+  // import wrote (which mbsgen import shows) are at the lines of that text.
+  if (is_urdf_path(path)) return read_model_string(import_urdf_file(path).yaml, path + " (as imported)");
+  return read_model_string(read_model_text(path), path);
+}
 
 }  // namespace mbsgen
