@@ -1,0 +1,45 @@
+# `mbsgen import` from the command line (issue 43, docs/urdf.md): the model it writes reads and
+# checks; it never overwrites a file it did not write and replaces its own; a malformed URDF is
+# exit 1 with FILE:LINE:COL and writes nothing; `mbsgen check` takes the .urdf itself and says
+# once what it did not import; an option naming no joint is refused.
+#   cmake -DMBSGEN=... -DURDF=.../ur5.urdf -DWORK=... -P check_import.cmake
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+execute_process(COMMAND ${MBSGEN} import ${URDF} --out ${WORK}/robot.yaml --elastic all --pose elbow_joint=0.5
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "mbsgen import failed: ${err}")
+endif()
+if(NOT err MATCHES "note: joint 'shoulder_lift_joint': friction 1.5 not imported")
+  message(FATAL_ERROR "no note of the friction it did not import: ${err}")
+endif()
+execute_process(COMMAND ${MBSGEN} check ${WORK}/robot.yaml RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "ok \\(")
+  message(FATAL_ERROR "the imported model does not check: ${out} ${err}")
+endif()
+# Its own file again: replaced. A user's file: refused, unchanged.
+execute_process(COMMAND ${MBSGEN} import ${URDF} --out ${WORK}/robot.yaml RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "re-importing over its own file failed: ${err}")
+endif()
+set(mine "model: mine\ncoordinates: [x]\n")
+file(WRITE ${WORK}/mine.yaml "${mine}")
+execute_process(COMMAND ${MBSGEN} import ${URDF} --out ${WORK}/mine.yaml RESULT_VARIABLE rc ERROR_VARIABLE err)
+file(READ ${WORK}/mine.yaml now)
+if(rc EQUAL 0 OR NOT now STREQUAL mine OR NOT err MATCHES "refusing to overwrite")
+  message(FATAL_ERROR "import overwrote a user's file (exit ${rc}): ${err}")
+endif()
+# A malformed URDF: the line and column, nothing written.
+file(WRITE ${WORK}/bad.urdf "<robot name=\"r\">\n  <link name=\"a\">\n</robot>\n")
+execute_process(COMMAND ${MBSGEN} import ${WORK}/bad.urdf --out ${WORK}/bad.yaml RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 1 OR NOT err MATCHES "bad.urdf:[0-9]+:[0-9]+: error: malformed XML" OR EXISTS ${WORK}/bad.yaml)
+  message(FATAL_ERROR "malformed URDF: exit ${rc}, ${err}")
+endif()
+execute_process(COMMAND ${MBSGEN} check ${URDF} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "ok \\(7 bodies, 6 coordinates\\)" OR NOT err MATCHES "friction")
+  message(FATAL_ERROR "mbsgen check of the .urdf: exit ${rc}, ${out} ${err}")
+endif()
+execute_process(COMMAND ${MBSGEN} import ${URDF} --elastic no_such_joint RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 1 OR NOT err MATCHES "--elastic: no joint 'no_such_joint'")
+  message(FATAL_ERROR "an unknown joint in --elastic: exit ${rc}, ${err}")
+endif()
