@@ -1,0 +1,953 @@
+// Reference dynamics of a URDF robot from two independent engines (tests/data/urdf/<robot>.engines.csv):
+// the joint-space mass matrix M(q), the bias c(q, q̇) + g(q) and the gravity forces g(q) on random
+// states, as MuJoCo computes them (mj_loadXML reads the URDF itself), checked against Orocos KDL
+// (kdl_parser::treeFromFile, KDL::TreeIdSolver_RNE) before anything is written.
+//
+//   urdf_engines OUT.csv FILE.urdf [--samples N] [--seed S] [--tolerance T] [--time]
+//
+// The recorded numbers are MuJoCo's; KDL's only enter the agreement check, and the file is
+// written (OUT.csv.tmp, then renamed) only when, on every state, max |X_mujoco − X_kdl| over the
+// largest |X_mujoco| of that state (floor 1e-300) is at most T (default 1e-10) for X = M, bias
+// and gravity; else exit 1 and nothing is written.
+//
+// How each engine computes them:
+//   MuJoCo  M: mj_kinematics, mj_comPos, mj_crb, mj_fullM. bias: mj_comVel, then
+//           mj_rne(flg_acc = 0) → the qfrc_bias of the state (q, q̇). gravity: the same at q̇ = 0.
+//           Joint armature would be added to M by mj_crb; it is zero in a URDF import, and set to
+//           zero after loading anyway, as are the URDF's damping and friction (MuJoCo keeps
+//           <dynamics damping> as dof_damping: a passive force, qfrc_passive, never in
+//           qfrc_bias, but zeroed all the same). Notes on stderr say what was found.
+//   KDL     the tree's recursive Newton–Euler (treeidsolver_recursive_newton_euler.hpp, also for
+//           a tree such as a biped): column j of M = ID(q, 0, e_j) with zero gravity; bias =
+//           ID(q, q̇, 0) and gravity = ID(q, 0, 0) with MuJoCo's gravity vector (m->opt.gravity,
+//           (0, 0, −9.81) by default). When the tree is a single chain, KDL::ChainDynParam
+//           (composite inertias) is compared as well.
+// Joints are matched by their URDF names (MuJoCo keeps them; kdl_parser names each segment's
+// joint after them); only 1-dof joints (revolute, continuous, prismatic; MuJoCo hinge and slide)
+// are accepted, and the two sets must be equal. Fixed joints are no coordinates in either (MuJoCo
+// fuses a fixed-jointed link into its parent, KDL keeps it as a segment with Joint::Fixed). A
+// <mimic> joint is recorded as an independent coordinate (M and the bias are those of the
+// unconstrained tree); a note says whether MuJoCo made an equality constraint of it (m->neq;
+// MuJoCo 2.2.2 makes none: it ignores <mimic>).
+//
+// Mass properties. MuJoCo's import must not change them: the sum of its body masses must equal the
+// sum of the URDF masses of the links that move (the root link, and links fixed to it, are fused
+// into MuJoCo's world body and dropped by kdl_parser; they carry no dynamics), and each body's
+// mass, centre of mass and inertia must match those computed here from the URDF (the link and the
+// links fused into it); a link without an <inertial> but with a <collision>, which MuJoCo would
+// weigh from its geometry (inertiafromgeom="auto") and KDL not, stops the run. Two corrections,
+// both written into the loaded mjModel and stated in OUT.csv's notes: (1) MuJoCo's compiler
+// diagonalizes full inertias only to about 1e-7 relative (see run), so every body's mass
+// properties are replaced by the URDF's, diagonalized in double; (2) MuJoCo 2.2 refuses to load a
+// moving body without mass or inertia, so such links are given placeholder inertials in a
+// temporary copy it loads, and the URDF's zeros are put back after loading. The kinematics (body
+// frames, joint axes) and the algorithms stay MuJoCo's.
+
+// States: std::mt19937_64(seed); per sample, q_i for each joint in MuJoCo's qpos order, uniform in
+// the joint's limits when MuJoCo has them finite (jnt_limited, jnt_range from the URDF's <limit>),
+// else in [−π, π] (hinge) or [−0.5, 0.5] m (slide); then q̇_i uniform in [−2, 2] rad/s or m/s.
+//
+// OUT.csv: '#' lines (provenance: the URDF's path, size and SHA-256, the engines' versions, seed,
+// gravity, the worst disagreements), then a header and one row per sample: q:<joint>…,
+// qd:<joint>…, M:<joint_i>:<joint_j> for i ≤ j (upper triangle, row by row, qpos order),
+// bias:<joint>… (the generalized force the actuators must supply for zero acceleration, MuJoCo's
+// qfrc_bias sign: M q̈ + bias = τ), gravity:<joint>… (g(q)); values %.17g.
+//
+// --time: after the check, the median time per call (thread CPU time; 21 repetitions of batches
+// of about 2 ms, the engines interleaved round robin, as in bench/engines_bench.cpp) of M and of
+// the bias for each engine, written to stdout as engine,quantity,ns_per_call. KDL's M is n tree
+// RNE passes (KDL has no composite-inertia solver for trees); "kdl_chain" is ChainDynParam
+// (JntToMass; JntToCoriolis + JntToGravity) when the robot is a chain.
+//
+// Built with the benchmarks (bench/CMakeLists.txt) when MuJoCo, KDL, kdl_parser, urdfdom and
+// tinyxml2 are found (Debian libmujoco-dev, liborocos-kdl-dev, libkdl-parser-dev). By hand, one line:
+//   g++ -O2 -std=c++17 -isystem /usr/include/eigen3 bench/urdf_engines.cpp -o /tmp/urdf_engines
+//       -lmujoco -lkdl_parser -lorocos-kdl -lurdfdom_model -ltinyxml2
+#include "harness.hpp"
+
+#include <Eigen/Dense>
+#include <kdl/chain.hpp>
+#include <kdl/chaindynparam.hpp>
+#include <kdl/config.h>
+#include <kdl/tree.hpp>
+#include <kdl/treeidsolver_recursive_newton_euler.hpp>
+#include <kdl_parser/kdl_parser.hpp>
+#include <mujoco/mujoco.h>
+#include <tinyxml2.h>
+#include <unistd.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <random>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+// ---- provenance ---------------------------------------------------------------------------------
+
+/// SHA-256 (FIPS 180-4) of `data`, as 64 hex digits.
+std::string sha256(const std::string& data) {
+  static const std::uint32_t k[64] = {
+      0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4, 0xab1c5ed5,
+      0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3, 0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174,
+      0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa, 0x5cb0a9dc, 0x76f988da,
+      0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967,
+      0x27b70a85, 0x2e1b2138, 0x4d2c6dfc, 0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85,
+      0xa2bfe8a1, 0xa81a664b, 0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070,
+      0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f, 0x682e6ff3,
+      0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2};
+  std::uint32_t h[8] = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
+                        0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+  std::string msg = data;
+  const std::uint64_t bits = static_cast<std::uint64_t>(data.size()) * 8;
+  msg += static_cast<char>(0x80);
+  while (msg.size() % 64 != 56) msg += '\0';
+  for (int i = 7; i >= 0; --i) msg += static_cast<char>((bits >> (8 * i)) & 0xff);
+  auto rotr = [](std::uint32_t x, int n) { return (x >> n) | (x << (32 - n)); };
+  for (std::size_t block = 0; block < msg.size(); block += 64) {
+    std::uint32_t w[64];
+    for (int i = 0; i < 16; ++i) {
+      w[i] = 0;
+      for (int b = 0; b < 4; ++b)
+        w[i] = (w[i] << 8) | static_cast<unsigned char>(msg[block + static_cast<std::size_t>(4 * i + b)]);
+    }
+    for (int i = 16; i < 64; ++i) {
+      const std::uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
+      const std::uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
+      w[i] = w[i - 16] + s0 + w[i - 7] + s1;
+    }
+    std::uint32_t a = h[0], b = h[1], c = h[2], d = h[3], e = h[4], f = h[5], g = h[6], hh = h[7];
+    for (int i = 0; i < 64; ++i) {
+      const std::uint32_t t1 = hh + (rotr(e, 6) ^ rotr(e, 11) ^ rotr(e, 25)) + ((e & f) ^ (~e & g)) + k[i] + w[i];
+      const std::uint32_t t2 = (rotr(a, 2) ^ rotr(a, 13) ^ rotr(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
+      hh = g;
+      g = f;
+      f = e;
+      e = d + t1;
+      d = c;
+      c = b;
+      b = a;
+      a = t1 + t2;
+    }
+    const std::uint32_t add[8] = {a, b, c, d, e, f, g, hh};
+    for (int i = 0; i < 8; ++i) h[i] += add[i];
+  }
+  char hex[65];
+  for (int i = 0; i < 8; ++i) std::snprintf(hex + 8 * i, 9, "%08x", h[i]);
+  return std::string(hex, 64);
+}
+
+std::string num17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+std::string num3(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+// ---- the URDF as written (urdfdom): masses, inertias, mimic joints ------------------------------
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+struct UrdfFacts {
+  urdf::ModelInterfaceSharedPtr model;
+  std::string robot;
+  double total_mass = 0;   ///< [kg] all links
+  double moving_mass = 0;  ///< [kg] links below at least one non-fixed joint
+  std::vector<std::string> massless_moving;  ///< moving links without <inertial> or with mass 0
+  std::map<std::string, std::string> mimic;  ///< joint → "mimics <joint> x multiplier + offset"
+};
+
+UrdfFacts urdf_facts(const std::string& text) {
+  UrdfFacts f;
+  f.model = urdf::parseURDF(text);
+  if (!f.model) throw std::runtime_error("urdfdom cannot parse the URDF");
+  f.robot = f.model->getName();
+  for (const auto& [name, link] : f.model->links_) {
+    const double mass = link->inertial ? link->inertial->mass : 0.0;
+    f.total_mass += mass;
+    bool moving = false;
+    for (urdf::LinkConstSharedPtr l = link; l && l->parent_joint; l = l->getParent())
+      if (l->parent_joint->type != urdf::Joint::FIXED) moving = true;
+    if (moving) {
+      f.moving_mass += mass;
+      if (mass == 0) f.massless_moving.push_back(name);
+    }
+  }
+  for (const auto& [name, joint] : f.model->joints_) {
+    if (joint->type == urdf::Joint::FLOATING || joint->type == urdf::Joint::PLANAR)
+      throw std::runtime_error("joint " + name + " is floating or planar; only 1-dof joints are compared");
+    if (joint->mimic)
+      f.mimic[name] = "mimics " + joint->mimic->joint_name + " x " + num17(joint->mimic->multiplier) + " + " +
+                      num17(joint->mimic->offset);
+  }
+  return f;
+}
+
+/// A URDF <origin> as a rigid transform (urdfdom's quaternion of the rpy, normalized).
+Eigen::Isometry3d transform(const urdf::Pose& p) {
+  double x, y, z, w;
+  p.rotation.getQuaternion(x, y, z, w);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
+  T.translation() = Vec3(p.position.x, p.position.y, p.position.z);
+  return T;
+}
+
+/// Mass m [kg], centre of mass c [m] and inertia I about c [kg m²], c and I in a link's frame.
+struct MassProperties {
+  double m = 0;
+  Vec3 c = Vec3::Zero();
+  Mat3 I = Mat3::Zero();
+};
+
+/// The mass properties of MuJoCo's body `link`: the link's <inertial> and those of the links fixed
+/// to it by fixed joints, recursively (MuJoCo's URDF import fuses them, fusestatic), in the link's
+/// frame, computed in double from the URDF's numbers.
+MassProperties fused_mass_properties(const urdf::ModelInterface& model, const std::string& link) {
+  std::vector<MassProperties> parts;  // each about its own centre of mass, in the link's frame
+  std::function<void(const urdf::LinkConstSharedPtr&, const Eigen::Isometry3d&)> add =
+      [&](const urdf::LinkConstSharedPtr& l, const Eigen::Isometry3d& T) {
+        if (l->inertial) {
+          const urdf::Inertial& in = *l->inertial;
+          const Eigen::Isometry3d Ti = T * transform(in.origin);
+          Mat3 I;
+          I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+          parts.push_back({in.mass, Ti.translation(), Ti.linear() * I * Ti.linear().transpose()});
+        }
+        for (const urdf::JointSharedPtr& j : l->child_joints)
+          if (j->type == urdf::Joint::FIXED)
+            add(model.getLink(j->child_link_name), T * transform(j->parent_to_joint_origin_transform));
+      };
+  const urdf::LinkConstSharedPtr root = model.getLink(link);
+  if (!root) throw std::runtime_error("MuJoCo body " + link + " is no URDF link");
+  add(root, Eigen::Isometry3d::Identity());
+  MassProperties r;
+  for (const MassProperties& p : parts) {
+    r.m += p.m;
+    r.c += p.m * p.c;
+  }
+  if (r.m > 0) r.c /= r.m;
+  for (const MassProperties& p : parts) {
+    const Vec3 d = p.c - r.c;
+    r.I += p.I + p.m * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
+  }
+  return r;
+}
+
+/// MuJoCo 2.2 refuses a body with a joint whose mass or moments of inertia are below mjMINVAL
+/// ("mass and inertia of moving bodies must be larger than mjMINVAL"), though M stays positive
+/// definite when the link's children carry mass. Such links (a moving parent joint, and no
+/// <inertial>, or mass 0, or zero moments) get a placeholder <inertial> (1 kg, 1 kg m² about the
+/// link's origin) in a copy that MuJoCo loads; the URDF's own mass properties replace it after
+/// loading (see run). Returns the copy's text, "" when no link needs it; `patched`: their names.
+std::string with_placeholder_inertials(const std::string& text, const urdf::ModelInterface& model,
+                                       std::vector<std::string>& patched) {
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS) throw std::runtime_error("tinyxml2 cannot parse the URDF");
+  tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  if (!robot) throw std::runtime_error("the URDF has no <robot>");
+  for (tinyxml2::XMLElement* e = robot->FirstChildElement("link"); e; e = e->NextSiblingElement("link")) {
+    const char* name = e->Attribute("name");
+    const urdf::LinkConstSharedPtr link = name ? model.getLink(name) : nullptr;
+    if (!link || !link->parent_joint || link->parent_joint->type == urdf::Joint::FIXED) continue;
+    const urdf::InertialSharedPtr& in = link->inertial;
+    if (in && in->mass > 0 && in->ixx > 0 && in->iyy > 0 && in->izz > 0) continue;
+    while (tinyxml2::XMLElement* old = e->FirstChildElement("inertial")) e->DeleteChild(old);
+    tinyxml2::XMLElement* inertial = doc.NewElement("inertial");
+    tinyxml2::XMLElement* mass = doc.NewElement("mass");
+    mass->SetAttribute("value", "1");
+    tinyxml2::XMLElement* inertia = doc.NewElement("inertia");
+    for (const char* a : {"ixx", "iyy", "izz"}) inertia->SetAttribute(a, "1");
+    for (const char* a : {"ixy", "ixz", "iyz"}) inertia->SetAttribute(a, "0");
+    inertial->InsertEndChild(mass);
+    inertial->InsertEndChild(inertia);
+    e->InsertEndChild(inertial);
+    patched.push_back(name);
+  }
+  if (patched.empty()) return "";
+  tinyxml2::XMLPrinter printer;
+  doc.Print(&printer);
+  return printer.CStr();
+}
+
+// ---- MuJoCo -------------------------------------------------------------------------------------
+
+struct MuJoCo {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  std::vector<double> M;  // dense, nv × nv, row-major
+
+  explicit MuJoCo(const std::string& path) {
+    char error[1000] = "";
+    m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
+    if (!m) throw std::runtime_error("MuJoCo cannot load " + path + ": " + error);
+    d = mj_makeData(m);
+    M.resize(static_cast<std::size_t>(m->nv * m->nv));
+  }
+  ~MuJoCo() {
+    if (d) mj_deleteData(d);
+    if (m) mj_deleteModel(m);
+  }
+  MuJoCo(const MuJoCo&) = delete;
+  MuJoCo& operator=(const MuJoCo&) = delete;
+
+  void mass_matrix(const double* q) {
+    mju_copy(d->qpos, q, m->nq);
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_crb(m, d);
+    mj_fullM(m, M.data(), d->qM);
+  }
+  /// qfrc_bias at (q, q̇); q̇ = nullptr: at rest, the gravity forces.
+  void bias(const double* q, const double* qd) {
+    mju_copy(d->qpos, q, m->nq);
+    if (qd)
+      mju_copy(d->qvel, qd, m->nv);
+    else
+      mju_zero(d->qvel, m->nv);
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_comVel(m, d);
+    mj_rne(m, d, 0, d->qfrc_bias);
+  }
+};
+
+// ---- Orocos KDL ---------------------------------------------------------------------------------
+
+struct Kdl {
+  KDL::Tree tree;
+  std::unique_ptr<KDL::TreeIdSolver_RNE> rne, rne_no_gravity;
+  KDL::JntArray q, qd, qdd, zero, tau;
+  KDL::WrenchMap f_ext;  // empty: no external forces
+  Eigen::MatrixXd M;     // n × n, KDL's joint order
+  Eigen::VectorXd bias, gravity;
+  // When the tree is a single chain: the chain from the root to its leaf, and chain_index[k] = the
+  // tree's number of the chain's k-th joint.
+  std::unique_ptr<KDL::Chain> chain;
+  std::unique_ptr<KDL::ChainDynParam> dyn;
+  std::vector<unsigned> chain_index;
+  KDL::JntArray cq, cqd, ccoriolis, cgravity;
+  KDL::JntSpaceInertiaMatrix cH;
+  Eigen::MatrixXd chain_M;
+  Eigen::VectorXd chain_bias, chain_gravity;
+
+  Kdl(const std::string& path, const KDL::Vector& g) {
+    if (!kdl_parser::treeFromFile(path, tree)) throw std::runtime_error("kdl_parser cannot read " + path);
+    const unsigned n = tree.getNrOfJoints();
+    rne = std::make_unique<KDL::TreeIdSolver_RNE>(tree, g);
+    rne_no_gravity = std::make_unique<KDL::TreeIdSolver_RNE>(tree, KDL::Vector::Zero());
+    for (KDL::JntArray* a : {&q, &qd, &qdd, &zero, &tau}) a->resize(n);
+    M.resize(n, n);
+    bias.resize(n);
+    gravity.resize(n);
+
+    // A chain when no segment has two children.
+    const KDL::SegmentMap& segments = tree.getSegments();
+    std::string leaf = tree.getRootSegment()->first;
+    bool is_chain = true;
+    for (KDL::SegmentMap::const_iterator s = tree.getRootSegment();;) {
+      const auto& children = GetTreeElementChildren(s->second);
+      if (children.size() > 1) {
+        is_chain = false;
+        break;
+      }
+      if (children.empty()) break;
+      s = children.front();
+      leaf = s->first;
+    }
+    if (!is_chain || segments.empty()) return;
+    chain = std::make_unique<KDL::Chain>();
+    if (!tree.getChain(tree.getRootSegment()->first, leaf, *chain) || chain->getNrOfJoints() != n) {
+      chain.reset();
+      return;
+    }
+    for (unsigned k = 0; k < chain->getNrOfSegments(); ++k) {
+      const KDL::Joint& joint = chain->getSegment(k).getJoint();
+      if (joint.getType() == KDL::Joint::Fixed) continue;
+      for (const auto& [name, element] : segments)
+        if (GetTreeElementSegment(element).getJoint().getName() == joint.getName() &&
+            GetTreeElementSegment(element).getJoint().getType() != KDL::Joint::Fixed)
+          chain_index.push_back(GetTreeElementQNr(element));
+    }
+    if (chain_index.size() != n) {
+      chain.reset();
+      return;
+    }
+    dyn = std::make_unique<KDL::ChainDynParam>(*chain, g);
+    for (KDL::JntArray* a : {&cq, &cqd, &ccoriolis, &cgravity}) a->resize(n);
+    cH.resize(n);
+    chain_M.resize(n, n);
+    chain_bias.resize(n);
+    chain_gravity.resize(n);
+  }
+  Kdl(const Kdl&) = delete;
+  Kdl& operator=(const Kdl&) = delete;
+
+  /// Joint name → the tree's joint number, 1-dof joints only.
+  std::map<std::string, unsigned> joint_numbers() const {
+    std::map<std::string, unsigned> v;
+    for (const auto& [name, element] : tree.getSegments()) {
+      const KDL::Joint& joint = GetTreeElementSegment(element).getJoint();
+      if (joint.getType() != KDL::Joint::Fixed) v[joint.getName()] = GetTreeElementQNr(element);
+    }
+    return v;
+  }
+
+  // The inputs in KDL's order; each throws when a solver reports an error.
+  void check(int status, const char* what) const {
+    if (status < 0) throw std::runtime_error(std::string("KDL ") + what + " failed, status " + std::to_string(status));
+  }
+  void mass_matrix() {
+    const Eigen::Index n = q.data.size();
+    zero.data.setZero();
+    for (Eigen::Index j = 0; j < n; ++j) {
+      qdd.data.setZero();
+      qdd(static_cast<unsigned>(j)) = 1.0;
+      check(rne_no_gravity->CartToJnt(q, zero, qdd, f_ext, tau), "TreeIdSolver_RNE (M)");
+      M.col(j) = tau.data;
+    }
+  }
+  void bias_and_gravity(bool with_bias = true, bool with_gravity = true) {
+    zero.data.setZero();
+    if (with_bias) {
+      check(rne->CartToJnt(q, qd, zero, f_ext, tau), "TreeIdSolver_RNE (bias)");
+      bias = tau.data;
+    }
+    if (with_gravity) {
+      check(rne->CartToJnt(q, zero, zero, f_ext, tau), "TreeIdSolver_RNE (gravity)");
+      gravity = tau.data;
+    }
+  }
+  void chain_set() {
+    for (std::size_t k = 0; k < chain_index.size(); ++k) {
+      cq(static_cast<unsigned>(k)) = q(chain_index[k]);
+      cqd(static_cast<unsigned>(k)) = qd(chain_index[k]);
+    }
+  }
+  void chain_mass_matrix() {
+    chain_set();
+    check(dyn->JntToMass(cq, cH), "ChainDynParam::JntToMass");
+  }
+  void chain_bias_and_gravity() {
+    chain_set();
+    check(dyn->JntToCoriolis(cq, cqd, ccoriolis), "ChainDynParam::JntToCoriolis");
+    check(dyn->JntToGravity(cq, cgravity), "ChainDynParam::JntToGravity");
+  }
+  /// The chain's results in the tree's order.
+  void chain_all() {
+    chain_mass_matrix();
+    chain_bias_and_gravity();
+    const std::size_t n = chain_index.size();
+    for (std::size_t a = 0; a < n; ++a) {
+      const auto ia = static_cast<Eigen::Index>(chain_index[a]);
+      chain_bias(ia) = ccoriolis.data(static_cast<Eigen::Index>(a)) + cgravity.data(static_cast<Eigen::Index>(a));
+      chain_gravity(ia) = cgravity.data(static_cast<Eigen::Index>(a));
+      for (std::size_t b = 0; b < n; ++b)
+        chain_M(ia, static_cast<Eigen::Index>(chain_index[b])) =
+            cH(static_cast<unsigned>(a), static_cast<unsigned>(b));
+    }
+  }
+};
+
+// ---- agreement ----------------------------------------------------------------------------------
+
+/// max |ref − x| / max(max |ref|, 1e-300): the disagreement relative to the recorded numbers.
+double relative_difference(const double* ref, const double* x, std::size_t n) {
+  double diff = 0, scale = 1e-300;
+  for (std::size_t i = 0; i < n; ++i) {
+    diff = std::max(diff, std::abs(ref[i] - x[i]));
+    scale = std::max(scale, std::abs(ref[i]));
+  }
+  return diff / scale;
+}
+
+// ---- timing (as bench/engines_bench.cpp) --------------------------------------------------------
+
+/// This thread's CPU time [s]: the engines compute on one thread without waiting, so it leaves out
+/// the intervals in which the shared machine ran something else on this core.
+double thread_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+struct Timed {
+  std::string engine, quantity;
+  std::function<void(long)> run;  ///< `calls` calls, cycling through the states
+  bench::Timing t;
+};
+
+/// Sizes a batch of each to at least min_batch_s (a warm-up call, then the faster of two tries of
+/// each batch size), then times `repetitions` batches of each in round robin; per call, the median
+/// and spread of the batches.
+void time_interleaved(std::vector<Timed>& timed, int repetitions, double min_batch_s) {
+  std::vector<std::vector<double>> per_call(timed.size());
+  for (Timed& x : timed) {
+    x.run(1);
+    long calls = 1;
+    for (;;) {
+      double s = INFINITY;
+      for (int attempt = 0; attempt < 2; ++attempt) {
+        const double t0 = thread_seconds();
+        x.run(calls);
+        s = std::min(s, thread_seconds() - t0);
+      }
+      if (s >= min_batch_s / 4 || calls > (1L << 30)) {
+        x.t.calls_per_repetition =
+            std::max(1L, static_cast<long>(std::ceil(static_cast<double>(calls) * min_batch_s / std::max(s, 1e-9))));
+        break;
+      }
+      calls *= 4;
+    }
+    x.t.repetitions = repetitions;
+  }
+  for (int rep = 0; rep < repetitions; ++rep)
+    for (std::size_t i = 0; i < timed.size(); ++i) {
+      const double t0 = thread_seconds();
+      timed[i].run(timed[i].t.calls_per_repetition);
+      per_call[i].push_back((thread_seconds() - t0) / static_cast<double>(timed[i].t.calls_per_repetition));
+    }
+  for (std::size_t i = 0; i < timed.size(); ++i) {
+    timed[i].t.median = bench::median_of(per_call[i]);
+    timed[i].t.min = *std::min_element(per_call[i].begin(), per_call[i].end());
+    timed[i].t.max = *std::max_element(per_call[i].begin(), per_call[i].end());
+  }
+}
+
+// ---- command line -------------------------------------------------------------------------------
+
+struct Options {
+  std::string out, urdf;
+  int samples = 100;
+  std::uint64_t seed = 20261129;
+  double tolerance = 1e-10;
+  bool time = false;
+};
+
+const char* const kUsage =
+    "usage: urdf_engines OUT.csv FILE.urdf [--samples N (100)] [--seed S (20261129)] [--tolerance T (1e-10)] "
+    "[--time]";
+
+Options parse(int argc, char** argv) {
+  Options o;
+  std::vector<std::string> positional;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (a == "--samples" && has_value) {
+      o.samples = std::stoi(argv[++i]);
+    } else if (a == "--seed" && has_value) {
+      o.seed = std::stoull(argv[++i]);
+    } else if (a == "--tolerance" && has_value) {
+      o.tolerance = std::stod(argv[++i]);
+    } else if (a == "--time") {
+      o.time = true;
+    } else if (!a.empty() && a[0] != '-') {
+      positional.push_back(a);
+    } else {
+      throw std::invalid_argument(kUsage);
+    }
+  }
+  if (positional.size() != 2 || o.samples < 1 || !(o.tolerance >= 0)) throw std::invalid_argument(kUsage);
+  o.out = positional[0];
+  o.urdf = positional[1];
+  return o;
+}
+
+int run(const Options& opt) {
+  std::ifstream in(opt.urdf, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + opt.urdf);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const UrdfFacts facts = urdf_facts(text);
+  std::vector<std::string> notes;
+  auto note = [&notes](const std::string& s) {
+    notes.push_back(s);
+    std::fprintf(stderr, "urdf_engines: note: %s\n", s.c_str());
+  };
+
+  // MuJoCo: its joints in qpos order, each 1-dof, and nothing added to M or the bias. It loads the
+  // URDF itself, or a copy with placeholder inertials (with_placeholder_inertials).
+  std::vector<std::string> patched;
+  const std::string patched_text = with_placeholder_inertials(text, *facts.model, patched);
+  std::unique_ptr<MuJoCo> mj_owner;
+  if (patched.empty()) {
+    mj_owner = std::make_unique<MuJoCo>(opt.urdf);
+  } else {
+    std::string s;
+    for (const auto& l : patched) s += (s.empty() ? "" : " ") + l;
+    note("MuJoCo 2.2 refuses moving bodies without mass or inertia; placeholder inertials given to it for " + s +
+         ", replaced by the URDF's after loading");
+    const std::filesystem::path copy = std::filesystem::temp_directory_path() /
+                                       ("urdf_engines_" + std::to_string(getpid()) + ".urdf");
+    std::ofstream(copy, std::ios::binary) << patched_text;
+    try {
+      mj_owner = std::make_unique<MuJoCo>(copy.string());
+    } catch (...) {
+      std::filesystem::remove(copy);
+      throw;
+    }
+    std::filesystem::remove(copy);
+  }
+  const UrdfFacts loaded = patched.empty() ? facts : urdf_facts(patched_text);  // what MuJoCo was given
+  MuJoCo& mj = *mj_owner;
+  const mjModel* m = mj.m;
+  const int n = m->nq;
+  if (m->nv != n || m->njnt != n)
+    throw std::runtime_error("MuJoCo made " + std::to_string(m->njnt) + " joints, " + std::to_string(m->nq) +
+                             " positions, " + std::to_string(m->nv) + " velocities: not all joints are 1-dof");
+  std::vector<std::string> names(static_cast<std::size_t>(n));
+  std::vector<int> joint_of(static_cast<std::size_t>(n));  // qpos index → joint id
+  for (int j = 0; j < m->njnt; ++j) {
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
+      throw std::runtime_error(std::string("MuJoCo joint ") + (name ? name : "(unnamed)") + " is not a hinge or slide");
+    if (!name) throw std::runtime_error("MuJoCo has an unnamed joint");
+    const std::string s = name;
+    if (s.find_first_of(",\":\n\r") != std::string::npos)
+      throw std::runtime_error("joint name '" + s + "' holds one of , \" : or a line break (CSV columns)");
+    names[static_cast<std::size_t>(m->jnt_qposadr[j])] = s;
+    joint_of[static_cast<std::size_t>(m->jnt_qposadr[j])] = j;
+  }
+  auto zero_out = [&](mjtNum* v, int count, const char* what) {
+    double largest = 0;
+    for (int i = 0; i < count; ++i) largest = std::max(largest, std::abs(v[i]));
+    if (largest > 0) note(std::string("MuJoCo had ") + what + " up to " + num3(largest) + "; set to 0");
+    mju_zero(v, count);
+  };
+  zero_out(m->dof_armature, m->nv, "dof_armature (added to M by mj_crb)");
+  zero_out(m->dof_damping, m->nv, "dof_damping (URDF <dynamics damping>; passive, not in qfrc_bias)");
+  zero_out(m->dof_frictionloss, m->nv, "dof_frictionloss (URDF <dynamics friction>; a constraint, not in qfrc_bias)");
+  zero_out(m->jnt_stiffness, m->njnt, "jnt_stiffness (passive, not in qfrc_bias)");
+  note("MuJoCo " + std::to_string(m->neq) + " equality constraint(s) (m->neq) after loading");
+  for (const auto& [joint, what] : facts.mimic)
+    note("mimic joint " + joint + " (" + what + "): " +
+         (m->neq > 0 ? "MuJoCo has equality constraints (neq > 0); " : "MuJoCo made no equality constraint; ") +
+         "recorded as an independent coordinate, M and bias of the unconstrained tree");
+  if (!facts.massless_moving.empty()) {
+    std::string s;
+    for (const auto& l : facts.massless_moving) s += (s.empty() ? "" : " ") + l;
+    note("links without mass below a moving joint: " + s);
+  }
+
+  // Masses: MuJoCo's bodies against the URDF's moving links, in total and body by body. MuJoCo's
+  // compiler diagonalizes each body's inertia (a URDF's off-diagonal terms, and the sum of fused
+  // links) with a Jacobi iteration, mju_eig3, that stops when the next rotation's cosine is within
+  // eigEPS = 1000 mjMINVAL = 1e-12 of 1 (an angle of about 1.4e-6 rad) or the largest off-diagonal
+  // term is below 1e-12 kg m²: its principal axes are off by up to about a microradian, and the
+  // inertia it represents by up to about 1e-7 of its largest entry (seen: 6e-8). So each body's mass
+  // properties are recomputed here in double from the URDF (fused_mass_properties), compared with
+  // MuJoCo's (a real change, such as inertia from geometry, stops the run), and written into the
+  // mjModel: body_mass, body_ipos, and body_iquat and body_inertia from Eigen's eigensolver; the
+  // kinematics (body frames, joint axes) and the algorithms stay MuJoCo's.
+  double mj_mass = 0;
+  for (int b = 1; b < m->nbody; ++b) mj_mass += m->body_mass[b];
+  note("mass [kg]: URDF all links " + num17(facts.total_mass) + ", URDF moving links " + num17(facts.moving_mass) +
+       ", MuJoCo bodies as loaded " + num17(mj_mass) + (patched.empty() ? "" : " (with the placeholders)") +
+       "; the root link and links fixed to it are fused into MuJoCo's world body and are no KDL segment");
+  if (std::abs(mj_mass - loaded.moving_mass) > 1e-12 * std::max(1.0, loaded.moving_mass))
+    throw std::runtime_error("MuJoCo's bodies weigh " + num17(mj_mass) + " kg, the moving links it was given " +
+                             num17(loaded.moving_mass) + " kg: MuJoCo's import changed the masses");
+  double worst_inertia = 0, worst_com = 0;
+  std::string worst_inertia_body;
+  for (int b = 1; b < m->nbody; ++b) {
+    const char* name = mj_id2name(m, mjOBJ_BODY, b);
+    if (!name) throw std::runtime_error("MuJoCo has an unnamed body");
+    const MassProperties u = fused_mass_properties(*loaded.model, name);  // as MuJoCo was given it
+    const Eigen::Quaterniond mq(m->body_iquat[4 * b], m->body_iquat[4 * b + 1], m->body_iquat[4 * b + 2],
+                                m->body_iquat[4 * b + 3]);
+    const Mat3 R = mq.normalized().toRotationMatrix();
+    const Mat3 I_mj = R * Vec3(m->body_inertia[3 * b], m->body_inertia[3 * b + 1], m->body_inertia[3 * b + 2]).asDiagonal() *
+                      R.transpose();
+    const double dI = (I_mj - u.I).cwiseAbs().maxCoeff(), scale_I = u.I.cwiseAbs().maxCoeff();
+    const double dc = (Vec3(m->body_ipos[3 * b], m->body_ipos[3 * b + 1], m->body_ipos[3 * b + 2]) - u.c).cwiseAbs().maxCoeff();
+    if (std::abs(m->body_mass[b] - u.m) > 1e-12 * std::max(1.0, u.m) || dc > 1e-9 || dI > 1e-5 * scale_I + 1e-10)
+      throw std::runtime_error("MuJoCo's body " + std::string(name) + " has mass " + num17(m->body_mass[b]) +
+                               " kg, the URDF " + num17(u.m) + " kg; its centre of mass differs by " + num3(dc) +
+                               " m, its inertia by " + num3(dI) + " kg m^2: MuJoCo's import changed it");
+    if (scale_I > 0 && dI / scale_I > worst_inertia) {
+      worst_inertia = dI / scale_I;
+      worst_inertia_body = name;
+    }
+    worst_com = std::max(worst_com, dc);
+    const MassProperties t = patched.empty() ? u : fused_mass_properties(*facts.model, name);  // the URDF's own
+    Mat3 V = Mat3::Identity();
+    Vec3 moments = t.I.diagonal();
+    if (!t.I.isDiagonal(0.0)) {
+      const Eigen::SelfAdjointEigenSolver<Mat3> es(t.I);
+      V = es.eigenvectors();
+      if (V.determinant() < 0) V.col(2) = -V.col(2);
+      moments = es.eigenvalues();
+    }
+    const Eigen::Quaterniond qi(V);
+    const double quat[4] = {qi.w(), qi.x(), qi.y(), qi.z()};
+    m->body_mass[b] = t.m;
+    mju_copy(m->body_ipos + 3 * b, t.c.data(), 3);
+    mju_copy(m->body_iquat + 4 * b, quat, 4);
+    mju_normalize4(m->body_iquat + 4 * b);
+    mju_copy(m->body_inertia + 3 * b, moments.data(), 3);
+  }
+  for (int b = 0; b < m->nbody; ++b) m->body_subtreemass[b] = m->body_mass[b];
+  for (int b = m->nbody - 1; b > 0; --b) m->body_subtreemass[m->body_parentid[b]] += m->body_subtreemass[b];
+  note("MuJoCo's compiled inertias differed from the URDF's by up to " + num3(worst_inertia) +
+       " of the body's largest entry (" + (worst_inertia_body.empty() ? "-" : worst_inertia_body) +
+       "), its centres of mass by up to " + num3(worst_com) +
+       " m; replaced by the URDF's, diagonalized in double (Eigen)");
+
+  // KDL, with MuJoCo's gravity; joints matched by name.
+  const KDL::Vector g(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]);
+  Kdl kdl(opt.urdf, g);
+  const std::map<std::string, unsigned> kdl_numbers = kdl.joint_numbers();
+  std::vector<unsigned> kdl_index(static_cast<std::size_t>(n));  // qpos index → KDL joint number
+  {
+    std::set<std::string> mj_set(names.begin(), names.end()), kdl_set;
+    for (const auto& [name, number] : kdl_numbers) kdl_set.insert(name);
+    if (mj_set != kdl_set || kdl.tree.getNrOfJoints() != static_cast<unsigned>(n) ||
+        static_cast<int>(mj_set.size()) != n) {
+      std::string only_mj, only_kdl;
+      for (const auto& s : mj_set)
+        if (!kdl_set.count(s)) only_mj += " " + s;
+      for (const auto& s : kdl_set)
+        if (!mj_set.count(s)) only_kdl += " " + s;
+      throw std::runtime_error("the engines' joints differ: MuJoCo " + std::to_string(n) + ", KDL " +
+                               std::to_string(kdl.tree.getNrOfJoints()) + "; only in MuJoCo:" +
+                               (only_mj.empty() ? " -" : only_mj) + "; only in KDL:" +
+                               (only_kdl.empty() ? " -" : only_kdl));
+    }
+    for (int i = 0; i < n; ++i) kdl_index[static_cast<std::size_t>(i)] = kdl_numbers.at(names[static_cast<std::size_t>(i)]);
+    bool same_order = true;
+    for (int i = 0; i < n; ++i) same_order = same_order && kdl_index[static_cast<std::size_t>(i)] == static_cast<unsigned>(i);
+    if (!same_order) note("KDL numbers the joints in another order than MuJoCo's qpos; matched by name");
+  }
+  note(std::string("KDL tree: ") + std::to_string(kdl.tree.getNrOfSegments()) + " segments, " +
+       (kdl.chain ? "a single chain: ChainDynParam compared too" : "branched: TreeIdSolver_RNE only"));
+
+  // The states.
+  const auto N = static_cast<std::size_t>(n);
+  const auto S = static_cast<std::size_t>(opt.samples);
+  std::vector<double> Q(S * N), QD(S * N);
+  std::vector<std::string> ranges(N);
+  {
+    std::mt19937_64 rng(opt.seed);
+    std::vector<std::uniform_real_distribution<double>> position;
+    for (std::size_t i = 0; i < N; ++i) {
+      const int j = joint_of[i];
+      const bool hinge = m->jnt_type[j] == mjJNT_HINGE;
+      double lo = hinge ? -M_PI : -0.5, hi = hinge ? M_PI : 0.5;
+      std::string how = hinge ? "hinge, no limits: [-pi, pi]" : "slide, no limits: [-0.5, 0.5] m";
+      if (m->jnt_limited[j]) {
+        const double a = m->jnt_range[2 * j], b = m->jnt_range[2 * j + 1];
+        if (std::isfinite(a) && std::isfinite(b) && a < b) {
+          lo = a;
+          hi = b;
+          how = std::string(hinge ? "hinge" : "slide") + ", limits [" + num17(a) + ", " + num17(b) + "]";
+        } else {
+          how += " (its range [" + num17(a) + ", " + num17(b) + "] is empty or infinite)";
+        }
+      }
+      ranges[i] = how;
+      position.emplace_back(lo, hi);
+    }
+    std::uniform_real_distribution<double> rate(-2.0, 2.0);
+    for (std::size_t s = 0; s < S; ++s) {
+      for (std::size_t i = 0; i < N; ++i) Q[s * N + i] = position[i](rng);
+      for (std::size_t i = 0; i < N; ++i) QD[s * N + i] = rate(rng);
+    }
+  }
+  auto to_kdl = [&](std::size_t s) {
+    for (std::size_t i = 0; i < N; ++i) {
+      kdl.q(kdl_index[i]) = Q[s * N + i];
+      kdl.qd(kdl_index[i]) = QD[s * N + i];
+    }
+  };
+
+  // Both engines on every state; MuJoCo's numbers kept.
+  std::vector<double> rec_M(S * N * N), rec_bias(S * N), rec_gravity(S * N);
+  double worst_M = 0, worst_bias = 0, worst_gravity = 0, worst_chain = 0;
+  std::vector<double> kM(N * N), kv(N);
+  for (std::size_t s = 0; s < S; ++s) {
+    const double *q = &Q[s * N], *qd = &QD[s * N];
+    mj.mass_matrix(q);
+    std::copy(mj.M.begin(), mj.M.end(), rec_M.begin() + static_cast<std::ptrdiff_t>(s * N * N));
+    mj.bias(q, qd);
+    std::copy(mj.d->qfrc_bias, mj.d->qfrc_bias + N, rec_bias.begin() + static_cast<std::ptrdiff_t>(s * N));
+    mj.bias(q, nullptr);
+    std::copy(mj.d->qfrc_bias, mj.d->qfrc_bias + N, rec_gravity.begin() + static_cast<std::ptrdiff_t>(s * N));
+
+    to_kdl(s);
+    kdl.mass_matrix();
+    kdl.bias_and_gravity();
+    auto compare = [&](const Eigen::MatrixXd& KM, const Eigen::VectorXd& kb, const Eigen::VectorXd& kg, double& wM,
+                       double& wb, double& wg) {
+      for (std::size_t a = 0; a < N; ++a)
+        for (std::size_t b = 0; b < N; ++b)
+          kM[a * N + b] = KM(static_cast<Eigen::Index>(kdl_index[a]), static_cast<Eigen::Index>(kdl_index[b]));
+      wM = std::max(wM, relative_difference(&rec_M[s * N * N], kM.data(), N * N));
+      for (std::size_t a = 0; a < N; ++a) kv[a] = kb(static_cast<Eigen::Index>(kdl_index[a]));
+      wb = std::max(wb, relative_difference(&rec_bias[s * N], kv.data(), N));
+      for (std::size_t a = 0; a < N; ++a) kv[a] = kg(static_cast<Eigen::Index>(kdl_index[a]));
+      wg = std::max(wg, relative_difference(&rec_gravity[s * N], kv.data(), N));
+    };
+    compare(kdl.M, kdl.bias, kdl.gravity, worst_M, worst_bias, worst_gravity);
+    if (kdl.chain) {
+      kdl.chain_all();
+      double cM = 0, cb = 0, cg = 0;
+      compare(kdl.chain_M, kdl.chain_bias, kdl.chain_gravity, cM, cb, cg);
+      worst_chain = std::max({worst_chain, cM, cb, cg});
+    }
+  }
+  std::fprintf(stderr,
+               "urdf_engines: %s, %d joints, %d samples: worst relative disagreement KDL (TreeIdSolver_RNE) vs "
+               "MuJoCo: M %.3g, bias %.3g, gravity %.3g",
+               facts.robot.c_str(), n, opt.samples, worst_M, worst_bias, worst_gravity);
+  if (kdl.chain) std::fprintf(stderr, "; KDL ChainDynParam vs MuJoCo (M, bias, gravity) %.3g", worst_chain);
+  std::fprintf(stderr, " (tolerance %.3g)\n", opt.tolerance);
+  if (std::max({worst_M, worst_bias, worst_gravity, worst_chain}) > opt.tolerance) {
+    std::fprintf(stderr, "urdf_engines: the engines disagree beyond the tolerance; %s not written\n",
+                 opt.out.c_str());
+    return 1;
+  }
+
+  // OUT.csv, all or nothing; the three readers (urdfdom here, MuJoCo, kdl_parser) read the file
+  // separately, so it must not have changed meanwhile.
+  {
+    std::ifstream again(opt.urdf, std::ios::binary);
+    const std::string now((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
+    if (now != text) throw std::runtime_error("the URDF changed while it was read; run again");
+  }
+  const std::string tmp = opt.out + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    if (!f) throw std::runtime_error("cannot write " + tmp);
+    f << "# Reference dynamics of a URDF robot, written by bench/urdf_engines.cpp; do not edit by hand.\n"
+      << "# urdf: " << opt.urdf << "\n"
+      << "# urdf_bytes: " << text.size() << "\n"
+      << "# urdf_sha256: " << sha256(text) << "\n"
+      << "# robot: " << facts.robot << "\n"
+      << "# recorded: MuJoCo " << mj_version()
+      << " (mj_loadXML of the URDF, its bodies' mass properties then set to the URDF's in double;"
+         " M: mj_crb + mj_fullM; bias and gravity: mj_rne, flg_acc = 0, qfrc_bias; armature, damping, friction,"
+         " stiffness zero)\n"
+      << "# checked against: Orocos KDL " << KDL_VERSION_STRING
+      << " (Debian liborocos-kdl 1.5.1; kdl_parser::treeFromFile; KDL::TreeIdSolver_RNE"
+      << (kdl.chain ? "; and KDL::ChainDynParam, the tree being a chain" : "") << ")\n"
+      << "# samples: " << opt.samples << ", seed: " << opt.seed
+      << " (std::mt19937_64; per sample q for each joint, then qd for each joint, std::uniform_real_distribution)\n"
+      << "# qd: uniform in [-2, 2] rad/s or m/s\n"
+      << "# gravity: " << num17(m->opt.gravity[0]) << " " << num17(m->opt.gravity[1]) << " "
+      << num17(m->opt.gravity[2]) << " m/s^2 (world frame; MuJoCo's default, given to KDL)\n";
+    for (std::size_t i = 0; i < N; ++i) f << "# joint " << i << ": " << names[i] << ", q: " << ranges[i] << "\n";
+    for (const std::string& s : notes) f << "# note: " << s << "\n";
+    f << "# worst relative disagreement KDL vs MuJoCo over the samples (max |difference| / max |MuJoCo| per sample): M "
+      << num3(worst_M) << ", bias " << num3(worst_bias) << ", gravity " << num3(worst_gravity);
+    if (kdl.chain) f << "; ChainDynParam " << num3(worst_chain);
+    f << " (tolerance " << num3(opt.tolerance) << ")\n"
+      << "# bias = c(q, qd) + g(q), the force for zero acceleration (M qdd + bias = tau); gravity = g(q); SI units\n";
+    std::string header;
+    auto col = [&header](const std::string& c) { header += (header.empty() ? "" : ",") + c; };
+    for (const auto& s : names) col("q:" + s);
+    for (const auto& s : names) col("qd:" + s);
+    for (std::size_t a = 0; a < N; ++a)
+      for (std::size_t b = a; b < N; ++b) col("M:" + names[a] + ":" + names[b]);
+    for (const auto& s : names) col("bias:" + s);
+    for (const auto& s : names) col("gravity:" + s);
+    f << header << "\n";
+    for (std::size_t s = 0; s < S; ++s) {
+      std::string row;
+      auto put = [&row](double v) { row += (row.empty() ? "" : ",") + num17(v); };
+      for (std::size_t i = 0; i < N; ++i) put(Q[s * N + i]);
+      for (std::size_t i = 0; i < N; ++i) put(QD[s * N + i]);
+      for (std::size_t a = 0; a < N; ++a)
+        for (std::size_t b = a; b < N; ++b) put(rec_M[s * N * N + a * N + b]);
+      for (std::size_t i = 0; i < N; ++i) put(rec_bias[s * N + i]);
+      for (std::size_t i = 0; i < N; ++i) put(rec_gravity[s * N + i]);
+      f << row << "\n";
+    }
+    f.flush();
+    if (!f) throw std::runtime_error("cannot write " + tmp);
+  }
+  std::filesystem::rename(tmp, opt.out);
+  std::fprintf(stderr, "urdf_engines: wrote %s\n", opt.out.c_str());
+
+  if (!opt.time) return 0;
+  // Each runs `calls` calls, state s = 0, 1, …, S − 1, 0, …
+  auto cycle = [S](std::function<void(std::size_t)> f) {
+    return [S, f](long calls) {
+      std::size_t s = 0;
+      for (long c = 0; c < calls; ++c) {
+        f(s);
+        if (++s == S) s = 0;
+      }
+    };
+  };
+  std::vector<Timed> timed;
+  auto add = [&timed](const char* engine, const char* quantity, std::function<void(long)> f) {
+    Timed x;
+    x.engine = engine;
+    x.quantity = quantity;
+    x.run = std::move(f);
+    timed.push_back(std::move(x));
+  };
+  add("mujoco", "M", cycle([&](std::size_t s) { mj.mass_matrix(&Q[s * N]); }));
+  add("mujoco", "bias", cycle([&](std::size_t s) { mj.bias(&Q[s * N], &QD[s * N]); }));
+  add("kdl", "M", cycle([&](std::size_t s) {
+        to_kdl(s);
+        kdl.mass_matrix();
+      }));
+  add("kdl", "bias", cycle([&](std::size_t s) {
+        to_kdl(s);
+        kdl.bias_and_gravity(true, false);
+      }));
+  if (kdl.chain) {
+    add("kdl_chain", "M", cycle([&](std::size_t s) {
+          to_kdl(s);
+          kdl.chain_mass_matrix();
+        }));
+    add("kdl_chain", "bias", cycle([&](std::size_t s) {
+          to_kdl(s);
+          kdl.chain_bias_and_gravity();
+        }));
+  }
+  time_interleaved(timed, 21, 0.002);
+  std::printf("engine,quantity,ns_per_call\n");
+  for (const Timed& x : timed) std::printf("%s,%s,%.4g\n", x.engine.c_str(), x.quantity.c_str(), x.t.median * 1e9);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt;
+  try {
+    opt = parse(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
+  try {
+    return run(opt);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "urdf_engines: %s: %s\n", opt.urdf.c_str(), e.what());
+    std::error_code ec;
+    std::filesystem::remove(opt.out + ".tmp", ec);
+    return 1;
+  }
+}
