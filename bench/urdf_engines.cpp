@@ -53,16 +53,45 @@
 // bias:<joint>… (the generalized force the actuators must supply for zero acceleration, MuJoCo's
 // qfrc_bias sign: M q̈ + bias = τ), gravity:<joint>… (g(q)); values %.17g.
 //
-// --time: after the check, the median time per call (thread CPU time; 21 repetitions of batches
-// of about 2 ms, the engines interleaved round robin, as in bench/engines_bench.cpp) of M and of
-// the bias for each engine, written to stdout as engine,quantity,ns_per_call. KDL's M is n tree
-// RNE passes (KDL has no composite-inertia solver for trees); "kdl_chain" is ChainDynParam
+// --time: after the check, the median time per call (thread CPU time; --reps repetitions, 21 by
+// default, of batches of about 2 ms, the engines interleaved round robin, as in
+// bench/engines_bench.cpp) of M, of the bias and of both (M+bias) for each engine, written to
+// stdout as engine,quantity,ns_per_call,min_ns,max_ns,calls_per_repetition,agreement (min and max:
+// the spread of the repetitions; agreement: the engine's worst relative difference to MuJoCo,
+// KDL's from the check on the sampled states above, ours' from its own check below, empty for
+// MuJoCo itself). MuJoCo's M+bias shares its position stages (mj_kinematics,
+// mj_comPos, mj_crb, mj_fullM, mj_comVel, mj_rne). KDL's M is n tree RNE passes (KDL has no
+// composite-inertia solver for trees), its bias one pass; "kdl_chain" is ChainDynParam
 // (JntToMass; JntToCoriolis + JntToGravity) when the robot is a chain.
 //
+// Ours (issue 43), in --time mode only: built with -DMBSGEN_URDF_KERNELS and the kernels of
+// `mbsgen generate ROBOT.urdf --id ROBOT_urdf --dynamics` on the include path (and linked), the
+// kernels of the robot (the URDF's <robot name> + "_urdf"; a robot whose header was not found is
+// not compiled in, and then only MuJoCo and KDL are timed) are a third engine: <id>_mass_matrix
+// (M), <id>_residual with u = 0 and every parameter `<joint>_damping` (URDF <dynamics damping>,
+// a passive force MuJoCo's qfrc_bias leaves out) set to 0 (k − q = c + g: the bias), and
+// <id>_dynamics (both in one kernel). Their coordinates are matched with MuJoCo's joints by name.
+// Before timing, on every state, ours' M, bias, gravity forces (the residual at q̇ = 0) and the
+// dynamics kernel's M and bias must agree with MuJoCo's to T (max |difference| over max |MuJoCo|
+// per state, as tests/generator/model/urdf_import_test.cpp's AgainstEngines), else exit 1 and
+// nothing is timed. A <mimic> joint is a constraint in ours (an expression constraint; MuJoCo
+// 2.2.2 and KDL ignore <mimic>): the kernels take the independent coordinates, so ours are
+// compared with MuJoCo's tree projected onto them, Tᵀ M T and Tᵀ bias (q = T q_ours + offset,
+// q_mimic = multiplier q_joint + offset: linear, so no T-dot term), on states where the mimic
+// holds (the sampled q and q̇ of the other joints, the mimic joint's from them), and then all
+// engines are timed on those states. Our public kernels of such a model first close the loop
+// (<id>_assemble: Newton from the operating point), and that is timed; MuJoCo and KDL are timed on
+// their unconstrained tree, without the projection they would need on top.
+//
 // Built with the benchmarks (bench/CMakeLists.txt) when MuJoCo, KDL, kdl_parser, urdfdom and
-// tinyxml2 are found (Debian libmujoco-dev, liborocos-kdl-dev, libkdl-parser-dev). By hand, one line:
+// tinyxml2 are found (Debian libmujoco-dev, liborocos-kdl-dev, libkdl-parser-dev); with ours when
+// the generator (the `mbsgen` target, with its URDF import) is built too. By hand, one line:
 //   g++ -O2 -std=c++17 -isystem /usr/include/eigen3 bench/urdf_engines.cpp -o /tmp/urdf_engines
 //       -lmujoco -lkdl_parser -lorocos-kdl -lurdfdom_model -ltinyxml2
+// and with ours, the kernels generated into DIR and compiled at -O2 into DIR/liburdf_kernels.a:
+//   g++ -O2 -std=c++17 -isystem /usr/include/eigen3 -DMBSGEN_URDF_KERNELS -I DIR bench/urdf_engines.cpp
+//       -o /tmp/urdf_engines DIR/liburdf_kernels.a -lmujoco -lkdl_parser -lorocos-kdl -lurdfdom_model -ltinyxml2
+// bench/urdf_speed.sh runs --time over the five robots of models/robots/urdf and tabulates it.
 #include "harness.hpp"
 
 #include <Eigen/Dense>
@@ -93,6 +122,25 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+// Our generated kernels (see "Ours" above): each robot whose header is on the include path.
+#ifdef MBSGEN_URDF_KERNELS
+#if __has_include("puma560_urdf.hpp")
+#include "puma560_urdf.hpp"
+#endif
+#if __has_include("ur5_urdf.hpp")
+#include "ur5_urdf.hpp"
+#endif
+#if __has_include("panda_urdf.hpp")
+#include "panda_urdf.hpp"
+#endif
+#if __has_include("biped_urdf.hpp")
+#include "biped_urdf.hpp"
+#endif
+#if __has_include("gripper_urdf.hpp")
+#include "gripper_urdf.hpp"
+#endif
+#endif
 
 namespace {
 
@@ -329,6 +377,17 @@ struct MuJoCo {
     mj_comVel(m, d);
     mj_rne(m, d, 0, d->qfrc_bias);
   }
+  /// M and qfrc_bias at (q, q̇), the position stages shared.
+  void both(const double* q, const double* qd) {
+    mju_copy(d->qpos, q, m->nq);
+    mju_copy(d->qvel, qd, m->nv);
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_crb(m, d);
+    mj_fullM(m, M.data(), d->qM);
+    mj_comVel(m, d);
+    mj_rne(m, d, 0, d->qfrc_bias);
+  }
 };
 
 // ---- Orocos KDL ---------------------------------------------------------------------------------
@@ -452,6 +511,12 @@ struct Kdl {
     check(dyn->JntToCoriolis(cq, cqd, ccoriolis), "ChainDynParam::JntToCoriolis");
     check(dyn->JntToGravity(cq, cgravity), "ChainDynParam::JntToGravity");
   }
+  void chain_both() {
+    chain_set();
+    check(dyn->JntToMass(cq, cH), "ChainDynParam::JntToMass");
+    check(dyn->JntToCoriolis(cq, cqd, ccoriolis), "ChainDynParam::JntToCoriolis");
+    check(dyn->JntToGravity(cq, cgravity), "ChainDynParam::JntToGravity");
+  }
   /// The chain's results in the tree's order.
   void chain_all() {
     chain_mass_matrix();
@@ -478,6 +543,213 @@ double relative_difference(const double* ref, const double* x, std::size_t n) {
     scale = std::max(scale, std::abs(ref[i]));
   }
   return diff / scale;
+}
+
+// ---- ours: mbsgen's generated kernels -----------------------------------------------------------
+
+/// One robot's generated kernels (<id>.hpp; docs/generated-abi.md).
+struct Kernels {
+  std::string id;
+  int n = 0, n_inputs = 0, n_parameters = 0;
+  int (*mass_matrix)(const double*, const double*, double*) = nullptr;
+  int (*residual)(const double*, const double*, const double*, const double*, double*) = nullptr;
+  int (*dynamics)(const double*, const double*, const double*, const double*, double*, double*) = nullptr;
+  const char* const* coordinate_names = nullptr;
+  const char* const* parameter_names = nullptr;
+  const double* parameter_defaults = nullptr;
+  int n_tree = 0;  ///< with constraints: the tree's coordinates, which the kernels reduce; else 0
+  const char* const* tree_coordinate_names = nullptr;
+};
+
+#define MBSGEN_URDF_KERNELS_OF(ID)                                                                       \
+  Kernels {                                                                                             \
+    #ID, ID##_n_coordinates, ID##_n_inputs, ID##_n_parameters, ID##_mass_matrix, ID##_residual,         \
+        ID##_dynamics, ID##_coordinate_names, ID##_parameter_names, ID##_parameter_defaults, 0, nullptr \
+  }
+
+/// The kernels compiled in (none without MBSGEN_URDF_KERNELS).
+std::vector<Kernels> compiled_kernels() {
+  std::vector<Kernels> v;
+#ifdef MBSGEN_URDF_KERNELS
+#if __has_include("puma560_urdf.hpp")
+  v.push_back(MBSGEN_URDF_KERNELS_OF(puma560_urdf));
+#ifdef puma560_urdf_HAS_CONSTRAINTS
+  v.back().n_tree = puma560_urdf_n_tree_coordinates;
+  v.back().tree_coordinate_names = puma560_urdf_tree_coordinate_names;
+#endif
+#endif
+#if __has_include("ur5_urdf.hpp")
+  v.push_back(MBSGEN_URDF_KERNELS_OF(ur5_urdf));
+#ifdef ur5_urdf_HAS_CONSTRAINTS
+  v.back().n_tree = ur5_urdf_n_tree_coordinates;
+  v.back().tree_coordinate_names = ur5_urdf_tree_coordinate_names;
+#endif
+#endif
+#if __has_include("panda_urdf.hpp")
+  v.push_back(MBSGEN_URDF_KERNELS_OF(panda_urdf));
+#ifdef panda_urdf_HAS_CONSTRAINTS
+  v.back().n_tree = panda_urdf_n_tree_coordinates;
+  v.back().tree_coordinate_names = panda_urdf_tree_coordinate_names;
+#endif
+#endif
+#if __has_include("biped_urdf.hpp")
+  v.push_back(MBSGEN_URDF_KERNELS_OF(biped_urdf));
+#ifdef biped_urdf_HAS_CONSTRAINTS
+  v.back().n_tree = biped_urdf_n_tree_coordinates;
+  v.back().tree_coordinate_names = biped_urdf_tree_coordinate_names;
+#endif
+#endif
+#if __has_include("gripper_urdf.hpp")
+  v.push_back(MBSGEN_URDF_KERNELS_OF(gripper_urdf));
+#ifdef gripper_urdf_HAS_CONSTRAINTS
+  v.back().n_tree = gripper_urdf_n_tree_coordinates;
+  v.back().tree_coordinate_names = gripper_urdf_tree_coordinate_names;
+#endif
+#endif
+#endif
+  return v;
+}
+
+/// Ours on one robot: the kernels, their parameters and inputs, and how their coordinates map to
+/// MuJoCo's: q_mujoco = T q_ours + offset, q̇_mujoco = T q̇_ours (T: n × f; the identity, up to
+/// the order, without <mimic>).
+struct Ours {
+  Kernels k;
+  std::size_t n = 0, f = 0;
+  bool reduced = false;  ///< f < n: <mimic> joints are constraints in ours
+  Eigen::MatrixXd T;
+  Eigen::VectorXd offset;
+  std::vector<std::size_t> at;  ///< ours' coordinate j → MuJoCo's qpos index of the same joint
+  std::vector<double> p, u, zero_rates, M, r, rg, M2, r2;
+  std::vector<std::string> zeroed;  ///< the damping parameters set to 0
+  // The states: ours' coordinates (S × f) and MuJoCo's (S × n) where the mimics hold.
+  std::vector<double> Qo, QDo, Qt, QDt;
+};
+
+/// Matches the kernels' coordinates with MuJoCo's joints (`names`, qpos order) by name; a joint
+/// that is none of ours must be a <mimic> of one (followed through mimics of mimics).
+std::unique_ptr<Ours> make_ours(const Kernels& k, const std::vector<std::string>& names,
+                                const urdf::ModelInterface& model) {
+  auto o = std::make_unique<Ours>();
+  o->k = k;
+  o->n = names.size();
+  o->f = static_cast<std::size_t>(k.n);
+  const std::size_t n = o->n, f = o->f;
+  std::map<std::string, std::size_t> ours;
+  for (std::size_t j = 0; j < f; ++j)
+    if (!ours.emplace(k.coordinate_names[j], j).second)
+      throw std::runtime_error(k.id + " names two coordinates " + k.coordinate_names[j]);
+  o->T = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(f));
+  o->offset = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+  o->at.assign(f, n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::string joint = names[i];
+    if (ours.count(joint)) o->at[ours.at(joint)] = i;
+    double a = 1, b = 0;  // q_(names[i]) = a q_joint + b
+    for (std::size_t depth = 0; !ours.count(joint); ++depth) {
+      const urdf::JointConstSharedPtr j = model.getJoint(joint);
+      if (!j || !j->mimic || depth > n)
+        throw std::runtime_error("MuJoCo's joint " + names[i] + " is none of " + k.id +
+                                 "'s coordinates, nor a <mimic> of one");
+      b += a * j->mimic->offset;
+      a *= j->mimic->multiplier;
+      joint = j->mimic->joint_name;
+    }
+    const auto ia = static_cast<Eigen::Index>(i);
+    o->T(ia, static_cast<Eigen::Index>(ours.at(joint))) = a;
+    o->offset(ia) = b;
+    if (joint != names[i]) o->reduced = true;
+  }
+  for (const auto& [name, j] : ours)
+    if (o->at[j] == n) throw std::runtime_error(k.id + "'s coordinate " + name + " is no joint of MuJoCo's");
+  if (o->reduced != (k.n_tree > 0))
+    throw std::runtime_error(k.id + (o->reduced ? " has no constraints, but MuJoCo has more joints (mimics)"
+                                                : " has constraints other than the URDF's <mimic> joints"));
+  if (o->reduced) {
+    std::set<std::string> tree(k.tree_coordinate_names, k.tree_coordinate_names + k.n_tree);
+    if (tree != std::set<std::string>(names.begin(), names.end()) || static_cast<std::size_t>(k.n_tree) != n)
+      throw std::runtime_error(k.id + "'s tree coordinates are not MuJoCo's joints");
+  }
+  o->p.assign(k.parameter_defaults, k.parameter_defaults + k.n_parameters);
+  for (int i = 0; i < k.n_parameters; ++i) {
+    const std::string name = k.parameter_names[i];
+    if (name.size() > 8 && name.compare(name.size() - 8, 8, "_damping") == 0) {
+      o->p[static_cast<std::size_t>(i)] = 0;
+      o->zeroed.push_back(name);
+    }
+  }
+  o->u.assign(static_cast<std::size_t>(std::max(1, k.n_inputs)), 0.0);
+  o->zero_rates.assign(f, 0.0);
+  o->M.resize(f * f);
+  o->M2.resize(f * f);
+  o->r.resize(f);
+  o->rg.resize(f);
+  o->r2.resize(f);
+  return o;
+}
+
+/// Ours' states from the sampled ones (S × n, qpos order): the independent coordinates taken as
+/// sampled, the mimic joints' from them.
+void ours_states(Ours& o, const std::vector<double>& Q, const std::vector<double>& QD, std::size_t S) {
+  const std::size_t n = o.n, f = o.f;
+  o.Qo.resize(S * f);
+  o.QDo.resize(S * f);
+  o.Qt = Q;
+  o.QDt = QD;
+  for (std::size_t s = 0; s < S; ++s)
+    for (std::size_t j = 0; j < f; ++j) {
+      o.Qo[s * f + j] = Q[s * n + o.at[j]];
+      o.QDo[s * f + j] = QD[s * n + o.at[j]];
+    }
+  if (!o.reduced) return;
+  for (std::size_t s = 0; s < S; ++s) {
+    const Eigen::Map<const Eigen::VectorXd> q(&o.Qo[s * f], static_cast<Eigen::Index>(f)),
+        qd(&o.QDo[s * f], static_cast<Eigen::Index>(f));
+    Eigen::Map<Eigen::VectorXd>(&o.Qt[s * n], static_cast<Eigen::Index>(n)) = o.T * q + o.offset;
+    Eigen::Map<Eigen::VectorXd>(&o.QDt[s * n], static_cast<Eigen::Index>(n)) = o.T * qd;
+  }
+}
+
+/// Ours against MuJoCo on every state: the worst relative differences (max |MuJoCo − ours| over
+/// max |MuJoCo| per state), MuJoCo's projected onto ours' coordinates (Tᵀ M T, Tᵀ bias).
+struct OursAgreement {
+  double M = 0, bias = 0, gravity = 0, dynamics = 0;
+};
+
+OursAgreement check_ours(Ours& o, MuJoCo& mj, std::size_t S) {
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const auto n = static_cast<Eigen::Index>(o.n), f = static_cast<Eigen::Index>(o.f);
+  const std::size_t ff = o.f * o.f;
+  const Kernels& k = o.k;
+  OursAgreement w;
+  RowMajor ref_M(f, f), ours_M(f, f), ours_M2(f, f);
+  Eigen::VectorXd ref_b(f), ref_g(f);
+  for (std::size_t s = 0; s < S; ++s) {
+    const double *qo = &o.Qo[s * o.f], *qdo = &o.QDo[s * o.f], *qt = &o.Qt[s * o.n], *qdt = &o.QDt[s * o.n];
+    auto ok = [&](int status, const char* kernel) {
+      if (status != 0)
+        throw std::runtime_error(k.id + "_" + kernel + " returned status " + std::to_string(status) + " at state " +
+                                 std::to_string(s));
+    };
+    ok(k.mass_matrix(qo, o.p.data(), o.M.data()), "mass_matrix");
+    ok(k.residual(qo, qdo, o.u.data(), o.p.data(), o.r.data()), "residual");
+    ok(k.residual(qo, o.zero_rates.data(), o.u.data(), o.p.data(), o.rg.data()), "residual (at rest)");
+    ok(k.dynamics(qo, qdo, o.u.data(), o.p.data(), o.M2.data(), o.r2.data()), "dynamics");
+    ours_M = Eigen::Map<const Eigen::MatrixXd>(o.M.data(), f, f);  // the kernels' M is column-major
+    ours_M2 = Eigen::Map<const Eigen::MatrixXd>(o.M2.data(), f, f);
+    mj.mass_matrix(qt);
+    ref_M = o.T.transpose() * Eigen::Map<const RowMajor>(mj.M.data(), n, n) * o.T;
+    mj.bias(qt, qdt);
+    ref_b = o.T.transpose() * Eigen::Map<const Eigen::VectorXd>(mj.d->qfrc_bias, n);
+    mj.bias(qt, nullptr);
+    ref_g = o.T.transpose() * Eigen::Map<const Eigen::VectorXd>(mj.d->qfrc_bias, n);
+    w.M = std::max(w.M, relative_difference(ref_M.data(), ours_M.data(), ff));
+    w.bias = std::max(w.bias, relative_difference(ref_b.data(), o.r.data(), o.f));
+    w.gravity = std::max(w.gravity, relative_difference(ref_g.data(), o.rg.data(), o.f));
+    w.dynamics = std::max({w.dynamics, relative_difference(ref_M.data(), ours_M2.data(), ff),
+                           relative_difference(ref_b.data(), o.r2.data(), o.f)});
+  }
+  return w;
 }
 
 // ---- timing (as bench/engines_bench.cpp) --------------------------------------------------------
@@ -541,11 +813,12 @@ struct Options {
   std::uint64_t seed = 20261129;
   double tolerance = 1e-10;
   bool time = false;
+  int repetitions = 21;  ///< --time
 };
 
 const char* const kUsage =
     "usage: urdf_engines OUT.csv FILE.urdf [--samples N (100)] [--seed S (20261129)] [--tolerance T (1e-10)] "
-    "[--time]";
+    "[--time] [--reps R (21)]";
 
 Options parse(int argc, char** argv) {
   Options o;
@@ -561,13 +834,15 @@ Options parse(int argc, char** argv) {
       o.tolerance = std::stod(argv[++i]);
     } else if (a == "--time") {
       o.time = true;
+    } else if (a == "--reps" && has_value) {
+      o.repetitions = std::stoi(argv[++i]);
     } else if (!a.empty() && a[0] != '-') {
       positional.push_back(a);
     } else {
       throw std::invalid_argument(kUsage);
     }
   }
-  if (positional.size() != 2 || o.samples < 1 || !(o.tolerance >= 0)) throw std::invalid_argument(kUsage);
+  if (positional.size() != 2 || o.samples < 1 || !(o.tolerance >= 0) || o.repetitions < 1) throw std::invalid_argument(kUsage);
   o.out = positional[0];
   o.urdf = positional[1];
   return o;
@@ -888,6 +1163,70 @@ int run(const Options& opt) {
   std::fprintf(stderr, "urdf_engines: wrote %s\n", opt.out.c_str());
 
   if (!opt.time) return 0;
+
+  // Ours, when the robot's kernels are compiled in (see the head of the file).
+  std::unique_ptr<Ours> ours;
+  {
+    std::string ids;
+    for (const Kernels& k : compiled_kernels()) {
+      ids += (ids.empty() ? "" : " ") + k.id;
+      if (k.id == facts.robot + "_urdf") ours = make_ours(k, names, *facts.model);
+    }
+    if (!ours)
+      std::fprintf(stderr, "urdf_engines: no kernels of ours for %s compiled in (%s); MuJoCo and KDL only\n",
+                   facts.robot.c_str(),
+                   ids.empty() ? "built without -DMBSGEN_URDF_KERNELS, or no header found" : ("only " + ids).c_str());
+  }
+  // The timed states: the sampled ones, or, when ours reduce <mimic> joints, those where the
+  // mimics hold (for all engines alike).
+  const std::vector<double>* TQ = &Q;
+  const std::vector<double>* TQD = &QD;
+  std::map<std::pair<std::string, std::string>, double> agreement;  // (engine, quantity) → vs MuJoCo
+  agreement[{"kdl", "M"}] = worst_M;
+  agreement[{"kdl", "bias"}] = std::max(worst_bias, worst_gravity);
+  agreement[{"kdl", "M+bias"}] = std::max({worst_M, worst_bias, worst_gravity});
+  if (kdl.chain)
+    for (const char* quantity : {"M", "bias", "M+bias"}) agreement[{"kdl_chain", quantity}] = worst_chain;
+  if (ours) {
+    ours_states(*ours, Q, QD, S);
+    std::string zeroed;
+    for (const auto& z : ours->zeroed) zeroed += " " + z;
+    std::fprintf(stderr, "urdf_engines: ours: %s, %zu coordinates; parameters set to 0:%s\n", ours->k.id.c_str(),
+                 ours->f, zeroed.empty() ? " none" : zeroed.c_str());
+    if (ours->reduced) {
+      std::string how;
+      for (const auto& [joint, what] : facts.mimic) how += "; " + joint + " " + what;
+      std::fprintf(stderr,
+                   "urdf_engines: ours take the %zu independent coordinates of %zu (<mimic> as a constraint%s): "
+                   "compared with MuJoCo's T^T M T and T^T bias, all engines checked and timed at the states where "
+                   "the mimics hold; MuJoCo and KDL timed on their unconstrained %zu-joint tree without the "
+                   "projection, ours with closing the loop (%s_assemble)\n",
+                   ours->f, ours->n, how.c_str(), ours->n, ours->k.id.c_str());
+      TQ = &ours->Qt;
+      TQD = &ours->QDt;
+    }
+    const OursAgreement w = check_ours(*ours, mj, S);
+    std::fprintf(stderr,
+                 "urdf_engines: %s, %d samples: worst relative disagreement ours (%s) vs MuJoCo: M %.3g, bias %.3g, "
+                 "gravity %.3g, dynamics kernel (M and bias) %.3g (tolerance %.3g)\n",
+                 facts.robot.c_str(), opt.samples, ours->k.id.c_str(), w.M, w.bias, w.gravity, w.dynamics,
+                 opt.tolerance);
+    if (std::max({w.M, w.bias, w.gravity, w.dynamics}) > opt.tolerance) {
+      std::fprintf(stderr, "urdf_engines: ours disagree with MuJoCo beyond the tolerance; nothing timed\n");
+      return 1;
+    }
+    agreement[{"ours", "M"}] = w.M;
+    agreement[{"ours", "bias"}] = std::max(w.bias, w.gravity);
+    agreement[{"ours", "M+bias"}] = w.dynamics;
+  }
+  const double *tq = TQ->data(), *tqd = TQD->data();
+  auto kdl_at = [&](std::size_t s) {
+    for (std::size_t i = 0; i < N; ++i) {
+      kdl.q(kdl_index[i]) = tq[s * N + i];
+      kdl.qd(kdl_index[i]) = tqd[s * N + i];
+    }
+  };
+
   // Each runs `calls` calls, state s = 0, 1, …, S − 1, 0, …
   auto cycle = [S](std::function<void(std::size_t)> f) {
     return [S, f](long calls) {
@@ -906,29 +1245,54 @@ int run(const Options& opt) {
     x.run = std::move(f);
     timed.push_back(std::move(x));
   };
-  add("mujoco", "M", cycle([&](std::size_t s) { mj.mass_matrix(&Q[s * N]); }));
-  add("mujoco", "bias", cycle([&](std::size_t s) { mj.bias(&Q[s * N], &QD[s * N]); }));
+  if (ours) {
+    Ours& o = *ours;
+    const Kernels& k = o.k;
+    const std::size_t F = o.f;
+    const double *qo = o.Qo.data(), *qdo = o.QDo.data(), *p = o.p.data(), *u = o.u.data();
+    double *M = o.M.data(), *r = o.r.data();
+    add("ours", "M", cycle([=](std::size_t s) { k.mass_matrix(qo + s * F, p, M); }));
+    add("ours", "bias", cycle([=](std::size_t s) { k.residual(qo + s * F, qdo + s * F, u, p, r); }));
+    add("ours", "M+bias", cycle([=](std::size_t s) { k.dynamics(qo + s * F, qdo + s * F, u, p, M, r); }));
+  }
+  add("mujoco", "M", cycle([&](std::size_t s) { mj.mass_matrix(tq + s * N); }));
+  add("mujoco", "bias", cycle([&](std::size_t s) { mj.bias(tq + s * N, tqd + s * N); }));
+  add("mujoco", "M+bias", cycle([&](std::size_t s) { mj.both(tq + s * N, tqd + s * N); }));
   add("kdl", "M", cycle([&](std::size_t s) {
-        to_kdl(s);
+        kdl_at(s);
         kdl.mass_matrix();
       }));
   add("kdl", "bias", cycle([&](std::size_t s) {
-        to_kdl(s);
+        kdl_at(s);
+        kdl.bias_and_gravity(true, false);
+      }));
+  add("kdl", "M+bias", cycle([&](std::size_t s) {
+        kdl_at(s);
+        kdl.mass_matrix();
         kdl.bias_and_gravity(true, false);
       }));
   if (kdl.chain) {
     add("kdl_chain", "M", cycle([&](std::size_t s) {
-          to_kdl(s);
+          kdl_at(s);
           kdl.chain_mass_matrix();
         }));
     add("kdl_chain", "bias", cycle([&](std::size_t s) {
-          to_kdl(s);
+          kdl_at(s);
           kdl.chain_bias_and_gravity();
         }));
+    add("kdl_chain", "M+bias", cycle([&](std::size_t s) {
+          kdl_at(s);
+          kdl.chain_both();
+        }));
   }
-  time_interleaved(timed, 21, 0.002);
-  std::printf("engine,quantity,ns_per_call\n");
-  for (const Timed& x : timed) std::printf("%s,%s,%.4g\n", x.engine.c_str(), x.quantity.c_str(), x.t.median * 1e9);
+  time_interleaved(timed, opt.repetitions, 0.002);
+  std::printf("engine,quantity,ns_per_call,min_ns,max_ns,calls_per_repetition,agreement\n");
+  for (const Timed& x : timed) {
+    const auto a = agreement.find({x.engine, x.quantity});
+    std::printf("%s,%s,%.4g,%.4g,%.4g,%ld,%s\n", x.engine.c_str(), x.quantity.c_str(), x.t.median * 1e9,
+                x.t.min * 1e9, x.t.max * 1e9, x.t.calls_per_repetition,
+                a == agreement.end() ? "" : num3(a->second).c_str());
+  }
   return 0;
 }
 
