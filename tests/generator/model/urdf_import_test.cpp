@@ -244,6 +244,36 @@ TEST(UrdfImport, FloatingBaseCarriesTheTotalMassInEveryDirection) {
     for (int j = 0; j < 3; ++j) EXPECT_NEAR(v[i * 3 + j], i == j ? 5.0 : 0.0, 1e-14) << i << "," << j;
 }
 
+TEST(UrdfImport, PlanarAndFloatingJointsMoveTheBodyFreely) {
+  // One body, centre of mass at its origin: M = diag(m, m, I_n) for a planar joint (two slides in
+  // the plane, the angle about the normal), m E in the translational block of a floating one.
+  const std::string planar = R"(<robot name="p"><link name="world"/>
+  <link name="a"><inertial><mass value="3"/><inertia ixx="0.2" iyy="0.3" izz="0.4"/></inertial></link>
+  <joint name="slide" type="planar"><parent link="world"/><child link="a"/><axis xyz="0 1 0"/></joint>
+</robot>)";
+  const Model p = import(planar);
+  ASSERT_EQ(p.coordinates().size(), 3u);
+  Equations eq = derive(p);
+  Digits digits;
+  std::vector<GiNaC::ex> m;
+  for (const auto& row : eq.M) m.insert(m.end(), row.begin(), row.end());
+  auto v = numbers(detail::PointEvaluator(eq.program, point(p, eq, {0.3, -0.2, 0.9}, {0.1, 0.2, 0.3})).evaluate(m));
+  const double expected[9] = {3, 0, 0, 0, 3, 0, 0, 0, 0.3};  // normal y: I_yy
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR(v[k], expected[k], 1e-14) << k;
+  std::string floating = planar;
+  floating.replace(floating.find("type=\"planar\""), 13, "type=\"floating\"");
+  const Model f = import(floating);
+  ASSERT_EQ(f.coordinates().size(), 6u);
+  Equations ef = derive(f);
+  std::vector<GiNaC::ex> block;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) block.push_back(ef.M[i][j]);
+  v = numbers(detail::PointEvaluator(ef.program, point(f, ef, {0.1, 0.2, 0.3, 0.4, 0.5, 0.6}, std::vector<double>(6, 0.2)))
+                  .evaluate(block));
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(v[i * 3 + j], i == j ? 3.0 : 0.0, 1e-14);
+}
+
 TEST(UrdfImport, MimicIsAConstraintAndReducesTheMassMatrix) {
   const std::string urdf = R"(<robot name="g"><link name="base"/>
   <link name="l"><inertial><mass value="0.5"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
