@@ -10,6 +10,8 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -30,6 +32,14 @@ bool is_urdf_path(const std::string& path) {
   std::string ext = path.substr(path.size() - 5);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext == ".urdf";
+}
+
+std::string urdf_import_checksum(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ULL;  // FNV-1a: a change, not an adversary, is what it detects
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "# mbsgen import checksum %016llx\n", static_cast<unsigned long long>(h));
+  return buf;
 }
 
 UrdfImport import_urdf_file(const std::string& path, const UrdfImportOptions& options) {
@@ -90,9 +100,14 @@ class Names {
     std::string id;
     for (unsigned char c : raw) id += (std::isalnum(c) || c == '_') && c < 0x80 ? static_cast<char>(c) : '_';
     if (id.empty() || !std::isalpha(static_cast<unsigned char>(id[0]))) id = "n" + id;
-    static const std::set<std::string> reserved = {"sin",  "cos",  "tan",  "exp",  "log",   "sqrt",  "abs",
-                                                   "asin", "acos", "atan", "atan2", "sinh", "cosh",  "tanh",
-                                                   "Pi",   "I",    "Euler", "Catalan", "pow", "world"};
+    // The reader's reserved words, and the plain scalars YAML reads as null or a boolean.
+    static const std::set<std::string> reserved = {
+        "sin",  "cos",  "tan",  "exp",  "log",  "sqrt", "abs",  "asin", "acos", "atan", "atan2", "sinh",
+        "cosh", "tanh", "Pi",   "I",    "Euler", "Catalan", "pow", "world", "null", "Null", "NULL", "true",
+        "True", "TRUE", "false", "False", "FALSE", "y", "Y", "n", "N", "yes", "Yes", "YES", "no", "No", "NO",
+        "on",   "On",   "ON",   "off",  "Off",  "OFF"};
+    // A symbol ending in _dot could be a coordinate's rate: none does.
+    if (id.size() >= 4 && id.compare(id.size() - 4, 4, "_dot") == 0) id += "_";
     std::string name = id;
     for (int k = 2; reserved.count(name) || used_.count(name); ++k) name = id + "_" + std::to_string(k);
     used_.insert(name);
@@ -100,6 +115,7 @@ class Names {
     return name;
   }
   void reserve(const std::string& name) { used_.insert(name); }
+  bool has(const std::string& name) const { return used_.count(name) > 0; }
 
  private:
   std::set<std::string> used_;
@@ -151,7 +167,7 @@ struct Pose {
 struct Link {
   std::string raw, id;  // the URDF's name; the body's (and parameters') name
   int line = 0, inertial_line = 0;
-  bool massive = false;
+  bool massive = false, rotated = false;  // rotated: an <inertial> rpy turned the tensor
   double mass = 0;
   Vec com = Vec::Zero();
   Mat inertia = Mat::Zero();  // about the centre of mass, link frame
@@ -198,18 +214,21 @@ class Importer {
   void read_link(const TiXmlElement* e);
   void read_joint(const TiXmlElement* e);
   void check_inertia(const Link& l, const TiXmlElement* at) const;
+  void check_tree();
+  void check_mimics_and_options();
   void place_root();
   void place(const std::string& joint);
   std::string intermediate_frame(const Joint& j, const std::string& parent_body);
   void add_coordinates(Joint& j);
   void compose_masses();
+  void settle(Mat& inertia, Vec& c, const std::string& body);
   void write(std::ostringstream& y);
   void write_parameters(std::ostringstream& y);
   void write_coordinates(std::ostringstream& y);
   void write_bodies(std::ostringstream& y);
   void write_forces(std::ostringstream& y);
   void write_outputs(std::ostringstream& y);
-  std::string where(int line) const { return std::filesystem::path(file_).filename().string() + ":" + std::to_string(line); }
+  std::string where(int line) const { return comment(std::filesystem::path(file_).filename().string()) + ":" + std::to_string(line); }
 
   const std::string& text_;
   const std::string file_;
@@ -237,7 +256,38 @@ class Importer {
 
 // ---- reading ----------------------------------------------------------------------------------
 
+// TinyXML parses (and frees) nested elements recursively: a file nested deeper than any robot
+// is refused before it is parsed. Counts start tags that do not close themselves, minus end tags
+// (comments, declarations and CDATA skipped); a conservative bound, not a parser.
+void refuse_deep_nesting(const std::string& text, const std::string& file) {
+  constexpr int kMaxDepth = 64;
+  int depth = 0, line = 1;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\n') ++line;
+    if (text[i] != '<' || i + 1 >= text.size()) continue;
+    const char c = text[i + 1];
+    if (c == '!' || c == '?') {
+      const char* end = text.compare(i, 4, "<!--") == 0 ? "-->" : text.compare(i, 9, "<![CDATA[") == 0 ? "]]>" : ">";
+      const std::size_t j = text.find(end, i);
+      if (j == std::string::npos) return;  // TinyXML says what is wrong
+      line += static_cast<int>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i), text.begin() + static_cast<std::ptrdiff_t>(j), '\n'));
+      i = j;
+      continue;
+    }
+    if (c == '/') {
+      --depth;
+      continue;
+    }
+    const std::size_t close = text.find('>', i);
+    if (close == std::string::npos) return;
+    if (text[close - 1] != '/' && ++depth > kMaxDepth)
+      throw ModelError({file, line, 0}, "elements nested more than " + std::to_string(kMaxDepth) +
+                                            " deep: not a robot description");
+  }
+}
+
 void Importer::parse_xml() {
+  refuse_deep_nesting(text_, file_);
   doc_.SetTabSize(1);
   doc_.Parse(text_.c_str(), nullptr, TIXML_ENCODING_UTF8);
   if (doc_.Error())
@@ -254,8 +304,11 @@ void Importer::parse_xml() {
     else if (tag == "joint")
       joint_elements_[e->Attribute("name") ? e->Attribute("name") : ""] = e;
     else
-      ++skipped_["<" + tag + ">"];
+      ++skipped_["<" + comment(tag) + ">"];
   }
+  constexpr std::size_t kMaxLinks = 10000;
+  if (links_.size() > kMaxLinks || joint_elements_.size() > kMaxLinks)
+    fail(robot, "more than " + std::to_string(kMaxLinks) + " links or joints: not imported");
   for (const TiXmlElement* e = robot->FirstChildElement("joint"); e; e = e->NextSiblingElement("joint")) read_joint(e);
 }
 
@@ -277,18 +330,19 @@ void Importer::check_with_urdfdom() {
   console_bridge::useOutputHandler(&captured);
   urdf::ModelInterfaceSharedPtr model;
   std::string thrown;
+  // urdfdom 3.0 passes the text of a bad number to console_bridge as a printf format: its copy
+  // has no '%' (a '%' is in no valid number; the importer reads the numbers from its own parse).
+  std::string neutral = text_;
+  std::replace(neutral.begin(), neutral.end(), '%', '?');
   try {
-    model = urdf::parseURDF(text_);
+    model = urdf::parseURDF(neutral);
   } catch (const std::exception& e) {
     thrown = e.what();
   }
   console_bridge::restorePreviousOutputHandler();
-  if (model && thrown.empty()) {
-    root_ = model->getRoot() ? model->getRoot()->name : "";
-    return;
-  }
-  std::string message = thrown.empty() ? "" : thrown;
-  for (const auto& e : captured.errors) message += (message.empty() ? "" : "; ") + e;
+  if (model && thrown.empty()) return;
+  std::string message = thrown.empty() ? "" : comment(thrown);
+  for (const auto& e : captured.errors) message += (message.empty() ? "" : "; ") + comment(e);
   if (message.empty()) message = "urdfdom refused the file";
   // The element whose name the message quotes first ("[name]" or "'name'").
   const TiXmlNode* at = doc_.RootElement();
@@ -309,7 +363,8 @@ Vec Importer::numbers(const TiXmlElement* e, const char* attribute, const Vec& f
   std::vector<double> v;
   for (std::string w; in >> w;) {
     double x = 0;
-    const auto r = std::from_chars(w.data(), w.data() + w.size(), x);
+    const std::size_t skip = w.size() > 1 && w[0] == '+' ? 1 : 0;  // xs:double allows a sign
+    const auto r = std::from_chars(w.data() + skip, w.data() + w.size(), x);
     if (r.ec != std::errc() || r.ptr != w.data() + w.size() || !std::isfinite(x))
       fail(e, std::string(attribute) + "=\"" + comment(text) + "\": '" + comment(w) + "' is not a finite number");
     v.push_back(x);
@@ -325,7 +380,8 @@ double Importer::number(const TiXmlElement* e, const char* attribute, double fal
   w.erase(0, w.find_first_not_of(" \t\r\n"));
   w.erase(w.find_last_not_of(" \t\r\n") + 1);
   double x = 0;
-  const auto r = std::from_chars(w.data(), w.data() + w.size(), x);
+  const std::size_t skip = w.size() > 1 && w[0] == '+' ? 1 : 0;
+  const auto r = std::from_chars(w.data() + skip, w.data() + w.size(), x);
   if (r.ec != std::errc() || r.ptr != w.data() + w.size() || !std::isfinite(x))
     fail(e, std::string(attribute) + "=\"" + comment(text) + "\" is not a finite number");
   return x;
@@ -354,7 +410,7 @@ void Importer::read_link(const TiXmlElement* e) {
   l.raw = e->Attribute("name") ? e->Attribute("name") : "";
   l.line = e->Row();
   for (const TiXmlElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement())
-    if (std::string(c->Value()) != "inertial") ++skipped_["<" + std::string(c->Value()) + ">"];
+    if (std::string(c->Value()) != "inertial") ++skipped_["<" + comment(c->Value()) + ">"];
   if (const TiXmlElement* in = e->FirstChildElement("inertial")) {
     const Pose p = pose_of(in);
     const TiXmlElement* mass = in->FirstChildElement("mass");
@@ -368,6 +424,7 @@ void Importer::read_link(const TiXmlElement* e) {
     check_inertia(l, i ? i : in);
     const Mat r = rpy_matrix(p.rpy);
     l.inertia = r * tensor * r.transpose();
+    l.rotated = !p.rpy.isZero(0);
     l.com = p.xyz;
     l.massive = l.mass > 0;
   }
@@ -404,6 +461,7 @@ void Importer::read_joint(const TiXmlElement* e) {
   if (const TiXmlElement* d = e->FirstChildElement("dynamics")) {
     j.damping = number(d, "damping", 0);
     j.friction = number(d, "friction", 0);
+    if (j.damping < 0 || j.friction < 0) fail(d, "joint '" + comment(j.raw) + "': negative damping or friction");
   }
   if (const TiXmlElement* l = e->FirstChildElement("limit")) {
     const std::string unit = j.type == "prismatic" ? "m" : "rad";
@@ -435,7 +493,10 @@ void Importer::place_root() {
   b.parent = "world";
   std::vector<std::string> q;
   for (const char* s : {"x", "y", "z", "yaw", "pitch", "roll"}) q.push_back(symbols_.take("base_" + std::string(s), nullptr, nullptr));
-  for (int k = 0; k < 6; ++k) coordinates_.push_back({q[k], k < 3 ? "m" : "rad"});
+  for (int k = 0; k < 6; ++k) {
+    coordinates_.push_back({q[k], k < 3 ? "m" : "rad"});
+    symbols_.reserve(q[k] + "_dot");
+  }
   b.translation = list({q[0], q[1], q[2]});
   b.rotation = "rotation: [{z: " + q[3] + "}, {y: " + q[4] + "}, {x: " + q[5] + "}]";
   b.source = "the floating base (import option): link '" + comment(root.raw) + "' (" + where(root.line) + ")";
@@ -557,10 +618,31 @@ void Importer::place(const std::string& name) {
     child.frame_body = child.owner = b.name;
     child.in_owner = Eigen::Isometry3d::Identity();
   }
-  for (const auto& c : child.children) place(c);
 }
 
 // ---- masses ---------------------------------------------------------------------------------------
+
+// A tensor the import turned or composed carries rounding that the file's numbers did not: what
+// is left of an exact zero (4 ulps of the largest moment) becomes 0, and a degenerate tensor (a
+// rod, a plate, two point masses), whose smallest principal moment or triangle margin rounding
+// may have pushed below zero where the reader decides exactly, gets 16 ulps of the largest moment
+// added to each principal moment (J + δE keeps J's axes; M moves by 1e-15 of itself).
+void Importer::settle(Mat& inertia, Vec& c, const std::string& body) {
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double scale = inertia.cwiseAbs().maxCoeff();
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(inertia(r, k)) <= 4 * eps * scale) inertia(r, k) = 0;
+  const double cscale = c.cwiseAbs().maxCoeff();
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(c(k)) <= 4 * eps * cscale) c(k) = 0;
+  const Vec m = Eigen::SelfAdjointEigenSolver<Mat>(inertia, Eigen::EigenvaluesOnly).eigenvalues();
+  if (scale > 0 && (m(0) < 16 * eps * scale || m(0) + m(1) - m(2) < 16 * eps * scale)) {
+    inertia += 16 * eps * scale * Mat::Identity();
+    notes_.push_back("body " + body + ": its turned or composed inertia is degenerate (a rod, a plate or point masses): " +
+                     num(16 * eps * scale) + " kg m^2 added to each principal moment so that rounding keeps it physical");
+  }
+}
 
 void Importer::compose_masses() {
   std::map<std::string, std::vector<const Link*>> by_owner;
@@ -598,15 +680,13 @@ void Importer::compose_masses() {
       const Vec d = parts[i].first - c;
       inertia += parts[i].second + it->second[i]->mass * (d.squaredNorm() * Mat::Identity() - d * d.transpose());
     }
-    // What rotating and composing leave of an exact zero is rounding: 4 ulps of the largest moment.
-    const double floor = 4 * std::numeric_limits<double>::epsilon() * inertia.cwiseAbs().maxCoeff();
-    for (int r = 0; r < 3; ++r)
-      for (int k = 0; k < 3; ++k)
-        if (std::abs(inertia(r, k)) <= floor) inertia(r, k) = 0;
-    const double cfloor = 4 * std::numeric_limits<double>::epsilon() * c.cwiseAbs().maxCoeff();
     Vec cc = c;
-    for (int k = 0; k < 3; ++k)
-      if (std::abs(cc(k)) <= cfloor) cc(k) = 0;
+    const bool as_written = parts.size() == 1 && !it->second[0]->rotated && it->second[0]->in_owner.isApprox(
+                                                                                 Eigen::Isometry3d::Identity(), 0);
+    if (!as_written) settle(inertia, cc, body.name);
+    if (!std::isfinite(m) || !cc.allFinite() || !inertia.allFinite())
+      throw ModelError({file_, it->second[0]->inertial_line, 0},
+                       "body " + body.name + ": its composed mass properties overflow double");
     const std::string src = parts.size() > 1 ? "composed of " + from : from;
     MassParameters p;
     auto param = [&](const std::string& suffix, double value, const char* unit) {
@@ -699,9 +779,9 @@ void Importer::write_forces(std::ostringstream& y) {
       std::string rhs = m.coordinates[0];
       if (j.multiplier != 1) rhs = num(j.multiplier) + "*" + rhs;
       if (j.offset != 0) rhs += (j.offset > 0 ? " + " : " - ") + num(std::abs(j.offset));
-      constraints.push_back("{type: expression, name: " + entities_.take(q + "_mimic", nullptr, nullptr) +
-                            ", expression: " + quoted(q + " - (" + rhs + ")") + "}");
-      notes_.push_back("joint '" + comment(j.raw) + "' mimics '" + comment(j.mimic) + "': the constraint " + q + "_mimic");
+      const std::string constraint = entities_.take(q + "_mimic", nullptr, nullptr);
+      constraints.push_back("{type: expression, name: " + constraint + ", expression: " + quoted(q + " - (" + rhs + ")") + "}");
+      notes_.push_back("joint '" + comment(j.raw) + "' mimics '" + comment(j.mimic) + "': the constraint " + constraint);
       continue;
     }
     if (all || elastic.count(j.raw)) {
@@ -739,10 +819,12 @@ void Importer::write_forces(std::ostringstream& y) {
     y << "\nconstraints:\n";
     for (const auto& c : constraints) y << "  - " << c << "\n";
     // The joints a mimic follows stay the independent ones (the linear model's coordinates).
-    std::vector<std::string> independent;
+    std::set<std::string> followers;
     for (const auto& name : joint_order_)
-      if (joints_.at(name).mimic.empty())
-        for (const auto& q : joints_.at(name).coordinates) independent.push_back(q);
+      if (!joints_.at(name).mimic.empty()) followers.insert(joints_.at(name).coordinates[0]);
+    std::vector<std::string> independent;
+    for (const auto& c : coordinates_)
+      if (!followers.count(c.first)) independent.push_back(c.first);
     y << "independent_coordinates: " << list(independent) << "\n";
   }
 }
@@ -796,41 +878,97 @@ void Importer::write_outputs(std::ostringstream& y) {
   }
 }
 
-UrdfImport Importer::run() {
-  parse_xml();
-  check_with_urdfdom();
-  // Options name joints and links of the file.
-  for (const auto& e : opt_.elastic)
-    if (e != "all" && !joints_.count(e)) throw ModelError({file_, 0, 0}, "--elastic: no joint '" + comment(e) + "' in the file");
-  for (const auto& [name, v] : opt_.pose) {
-    if (!joints_.count(name)) throw ModelError({file_, 0, 0}, "--pose: no joint '" + comment(name) + "' in the file");
-    if (!std::isfinite(v)) throw ModelError({file_, 0, 0}, "--pose: the value of '" + comment(name) + "' is not finite");
-  }
-  for (const auto& o : opt_.outputs)
-    if (!links_.count(o)) throw ModelError({file_, 0, 0}, "--output: no link '" + comment(o) + "' in the file");
-  for (double g : opt_.gravity)
-    if (!std::isfinite(g)) throw ModelError({file_, 0, 0}, "--gravity: not a finite vector");
+// The tree, checked here (urdfdom 3.0 does not): every joint's links exist, no link has two
+// parents, one root, every link reached from it; at least one joint moves.
+void Importer::check_tree() {
+  std::map<std::string, std::string> parent_joint;
   for (const auto& name : joint_order_) {
-    Joint& j = joints_.at(name);
-    links_.at(j.parent).children.push_back(name);
+    const Joint& j = joints_.at(name);
+    const TiXmlElement* at = joint_elements_.at(name);
+    for (const std::string* l : {&j.parent, &j.child})
+      if (!links_.count(*l)) fail(at, "joint '" + comment(j.raw) + "': no link '" + comment(*l) + "'");
+    auto [it, fresh] = parent_joint.emplace(j.child, name);
+    if (!fresh)
+      fail(at, "link '" + comment(j.child) + "' has two parents: joints '" + comment(it->second) + "' and '" +
+                   comment(name) + "'");
+  }
+  std::vector<std::string> roots;
+  for (const auto& name : link_order_)
+    if (!parent_joint.count(name)) roots.push_back(name);
+  if (roots.size() != 1)
+    fail(doc_.RootElement(), roots.empty() ? "no root link: the joints form a cycle"
+                                           : "two root links, '" + comment(roots[0]) + "' and '" + comment(roots[1]) + "'");
+  root_ = roots[0];
+  for (const auto& name : joint_order_) links_.at(joints_.at(name).parent).children.push_back(name);
+  std::set<std::string> reached{root_};
+  std::vector<std::string> stack{root_};
+  while (!stack.empty()) {
+    const std::string l = stack.back();
+    stack.pop_back();
+    for (const auto& j : links_.at(l).children)
+      if (reached.insert(joints_.at(j).child).second) stack.push_back(joints_.at(j).child);
+  }
+  for (const auto& name : link_order_)
+    if (!reached.count(name)) fail(doc_.RootElement()->FirstChildElement("link"), "link '" + comment(name) + "' is not connected to the root link '" + comment(root_) + "' (the joints form a cycle)");
+  if (std::all_of(joint_order_.begin(), joint_order_.end(), [&](const std::string& n) { return joints_.at(n).type == "fixed"; }) &&
+      !opt_.floating_base)
+    fail(doc_.RootElement(), "no joint moves (every joint is fixed): nothing to model");
+}
+
+void Importer::check_mimics_and_options() {
+  auto scalar = [](const std::string& t) { return t == "revolute" || t == "continuous" || t == "prismatic"; };
+  for (const auto& name : joint_order_) {
+    const Joint& j = joints_.at(name);
     if (j.mimic.empty()) continue;
     auto m = joints_.find(j.mimic);
     const TiXmlElement* at = joint_elements_.at(name)->FirstChildElement("mimic");
     if (m == joints_.end()) fail(at, "joint '" + comment(j.raw) + "' mimics '" + comment(j.mimic) + "', which is not a joint of the file");
-    auto scalar = [](const std::string& t) { return t == "revolute" || t == "continuous" || t == "prismatic"; };
-    if (!scalar(j.type) || !scalar(m->second.type) || !m->second.mimic.empty())
+    if (!scalar(j.type) || !scalar(m->second.type) || !m->second.mimic.empty() || m->first == name)
       fail(at, "joint '" + comment(j.raw) + "' mimics '" + comment(j.mimic) +
                    "': a mimic couples two revolute, continuous or prismatic joints, and not a mimic of a mimic");
   }
+  auto refuse = [](const std::string& what) { throw UrdfOptionError(what); };
+  for (const auto& e : opt_.elastic) {
+    if (e == "all") continue;
+    auto j = joints_.find(e);
+    if (j == joints_.end()) refuse("--elastic: no joint '" + comment(e) + "' in the file");
+    if (!scalar(j->second.type) || !j->second.mimic.empty())
+      refuse("--elastic: joint '" + comment(e) + "' is " + (j->second.mimic.empty() ? j->second.type : "a mimic") +
+             ": only revolute, continuous and prismatic joints that are not mimics get a spring");
+  }
+  for (const auto& [name, v] : opt_.pose) {
+    auto j = joints_.find(name);
+    if (j == joints_.end()) refuse("--pose: no joint '" + comment(name) + "' in the file");
+    if (!scalar(j->second.type)) refuse("--pose: joint '" + comment(name) + "' is " + j->second.type + ", not one angle or slide");
+    if (!std::isfinite(v)) refuse("--pose: the value of '" + comment(name) + "' is not finite");
+  }
+  for (const auto& o : opt_.outputs)
+    if (!links_.count(o)) refuse("--output: no link '" + comment(o) + "' in the file");
+  for (double g : opt_.gravity)
+    if (!std::isfinite(g)) refuse("--gravity: not a finite vector");
+  if (!(opt_.stiffness > 0) || !std::isfinite(opt_.stiffness) || !(opt_.damping >= 0) || !std::isfinite(opt_.damping))
+    refuse("--stiffness must be positive and --damping nonnegative (finite)");
+}
+
+UrdfImport Importer::run() {
+  parse_xml();
+  check_with_urdfdom();
+  check_tree();
+  check_mimics_and_options();
+  symbols_.reserve("g");  // gravity's magnitude
   for (const auto& name : link_order_) links_.at(name).id = entities_.take(name, &notes_, "link");
   place_root();
-  for (const auto& c : links_.at(root_).children) place(c);
-  compose_masses();
-  for (const auto& name : link_order_) {
-    const Link& l = links_.at(name);
-    if (l.frame_body.empty() && l.marker_body.empty() && name != root_)
-      notes_.push_back("link '" + comment(name) + "' is not connected to the tree");
+  // Depth first from the root, each joint's children in the file's order (no recursion: a chain
+  // of thousands of links is a loop, not a stack).
+  std::vector<std::string> stack(links_.at(root_).children.rbegin(), links_.at(root_).children.rend());
+  while (!stack.empty()) {
+    const std::string j = stack.back();
+    stack.pop_back();
+    place(j);
+    const auto& next = links_.at(joints_.at(j).child).children;
+    stack.insert(stack.end(), next.rbegin(), next.rend());
   }
+  compose_masses();
   std::string model = robot_;
   for (auto& c : model) c = std::isalnum(static_cast<unsigned char>(c)) && static_cast<unsigned char>(c) < 0x80 ? c : '_';
   if (model.empty() || !std::isalpha(static_cast<unsigned char>(model[0]))) model = "robot_" + model;
@@ -855,6 +993,7 @@ UrdfImport Importer::run() {
   write_coordinates(head);
   UrdfImport result;
   result.yaml = head.str() + y.str() + body.str();
+  result.yaml += urdf_import_checksum(result.yaml);
   result.notes = notes_;
   if (!skipped_.empty()) {
     std::string s = "not imported (no effect on the dynamics):";

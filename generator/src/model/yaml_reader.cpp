@@ -1740,7 +1740,16 @@ std::string read_model_text(const std::string& path) {
 Model read_model_file(const std::string& path) {
   // A URDF file is imported with the default options (urdf_import.hpp); YAML errors in what the
   // import wrote (which mbsgen import shows) are at the lines of that text.
-  if (is_urdf_path(path)) return read_model_string(import_urdf_file(path).yaml, path + " (as imported)");
+  if (is_urdf_path(path)) {
+    const std::string text = import_urdf_file(path).yaml;
+    try {
+      return read_model_string(text, path + " (as imported)");
+    } catch (const ModelError& e) {  // at lines of a text the user has not seen: say where to see it
+      throw ModelError({path, 0, 0}, "the model imported from it is refused: " + e.message() + " (at " +
+                                         e.where().str() + " of the text that `mbsgen import " + path +
+                                         "` prints)");
+    }
+  }
   return read_model_string(read_model_text(path), path);
 }
 

@@ -29,6 +29,7 @@
 
 #include <array>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,13 @@ struct UrdfImportOptions {
   bool inputs = true;
 };
 
+/// An option that names what the file does not have, or asks what cannot be (exit 2 on the
+/// command line: a usage error, not a bad file).
+class UrdfOptionError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
 struct UrdfImport {
   std::string yaml;                ///< the model file
   std::vector<std::string> notes;  ///< what was not imported or was changed, one line each
@@ -62,13 +70,20 @@ struct UrdfImport {
 bool is_urdf_path(const std::string& path);
 
 /// Imports the URDF text; `file_name` is used in messages and comments only. Throws ModelError
-/// (FILE:LINE:COL) for malformed XML, what urdfdom refuses (at the element it names when it
-/// names one), numbers that are not finite, a non-physical inertia or a zero mass with a nonzero
-/// inertia (at the link), a mimic of an unknown or non-scalar joint, a planar joint whose normal
-/// is not along an axis, and options naming unknown joints or links. ModelError at the file name
-/// when the build has no URDF support (urdfdom).
+/// (FILE:LINE:COL) for malformed XML or elements nested deeper than 64, what urdfdom refuses (at
+/// the element it names when it names one), a link with two parents, a cycle, a link not
+/// connected to the root, a file where nothing moves, numbers that are not finite, a negative
+/// mass, damping or friction, a non-physical inertia or a zero mass with a nonzero inertia (at
+/// the link), a mimic of an unknown, non-scalar or mimic joint, a planar joint whose normal is not
+/// along an axis; UrdfOptionError for options naming what the file lacks. ModelError at the file
+/// name when the build has no URDF support (urdfdom). The text ends with a line holding a
+/// checksum of the rest (`urdf_import_checksum`), by which mbsgen import knows a file it wrote
+/// and that nobody edited since.
 UrdfImport import_urdf_string(const std::string& text, const std::string& file_name,
                               const UrdfImportOptions& options = {});
+
+/// The checksum line mbsgen import ends its model file with, for `text` (everything before it).
+std::string urdf_import_checksum(const std::string& text);
 
 /// import_urdf_string of the file's text (read as read_model_text reads a model file).
 UrdfImport import_urdf_file(const std::string& path, const UrdfImportOptions& options = {});
