@@ -312,9 +312,9 @@ void Importer::parse_xml() {
   for (const TiXmlElement* e = robot->FirstChildElement("joint"); e; e = e->NextSiblingElement("joint")) read_joint(e);
 }
 
-// urdfdom checks the structure (one root, every joint's links known, no link with two parents,
-// the attributes of each element) and reports through console_bridge: its message, at the
-// element it names.
+// urdfdom checks each element's attributes and the tree it can build (one root, every joint's
+// links known; not a link with two parents or a cycle beside the root: check_tree does) and
+// reports through console_bridge: its message, at the element it names.
 class Captured : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
