@@ -87,32 +87,14 @@ def sympy_chain3():
     them that gives [M, Q, K, B, C], and the seconds of the import and of derivation + lambdify."""
     t0 = time.perf_counter()
     import sympy as sp
-    import sympy.physics.mechanics as me
+    sys.path.insert(0, os.path.join(ROOT, "bench", "peers"))
+    import sympy_chain  # noqa: E402  (imports sympy.physics.mechanics)
     t1 = time.perf_counter()
-    n = 3
-    q = me.dynamicsymbols("q1:%d" % (n + 1))
-    u = me.dynamicsymbols("u1:%d" % (n + 1))
-    m, l = sp.symbols("m1:%d" % (n + 1)), sp.symbols("l1:%d" % (n + 1))
-    k, c = sp.symbols("k1:%d" % (n + 1)), sp.symbols("c1:%d" % (n + 1))
-    g, force = sp.symbols("g F")
-    world, origin = me.ReferenceFrame("N"), me.Point("O")
-    origin.set_vel(world, 0)
-    particles, loads = [], []
-    parent, joint = world, origin
-    for i in range(n):
-        frame = parent.orientnew("A%d" % (i + 1), "Axis", [q[i], parent.z])
-        frame.set_ang_vel(parent, u[i] * parent.z)
-        point = joint.locatenew("P%d" % (i + 1), -l[i] * frame.y)
-        point.v2pt_theory(joint, world, frame)
-        particles.append(me.Particle("pa%d" % (i + 1), point, m[i]))
-        loads.append((point, -m[i] * g * world.y))
-        torque = (-k[i] * q[i] - c[i] * u[i]) * world.z  # on the relative angle q_i
-        loads.append((frame, torque))
-        if i > 0:
-            loads.append((parent, -torque))
-        parent, joint = frame, point
-    loads.append((joint, force * world.x))  # end_load: [F, 0, 0] at the end of link 3
-    km = me.KanesMethod(world, q_ind=q, u_ind=u, kd_eqs=[q[i].diff(me.dynamicsymbols._t) - u[i] for i in range(n)])
+    force = sp.Symbol("F")
+    parts = sympy_chain.chain(3, end_load=force)
+    km, particles, loads, q, u = parts["km"], parts["particles"], parts["loads"], parts["q"], parts["u"]
+    m, l, k, c, g = parts["m"], parts["l"], parts["k"], parts["c"], parts["g"]
+    world, origin, joint = parts["world"], parts["origin"], parts["end"]
     km.kanes_equations(particles, loads)
     op = {**{x: 0 for x in q}, **{x: 0 for x in u}, force: 0}
     f = km.forcing

@@ -39,7 +39,10 @@ def say(key, value):
     print(key, value, flush=True)
 
 
-def build(n):
+def chain(n, end_load=None):
+    """The chain's symbols, frames and Kane's equations: a dict with km, particles, loads, q, u,
+    m, l, k, c, g, world, origin and end (the last point); with `end_load` (a symbol), that force
+    along the world x axis acts at the end (bench/fit_vs_scipy.py's chain3_sympy with its F)."""
     q = me.dynamicsymbols("q1:%d" % (n + 1))
     u = me.dynamicsymbols("u1:%d" % (n + 1))
     m = sp.symbols("m1:%d" % (n + 1))
@@ -64,12 +67,21 @@ def build(n):
         if i > 0:
             loads.append((parent, -torque))
         parent, joint = frame, point
+    if end_load is not None:
+        loads.append((joint, end_load * world.x))
     kd = [q[i].diff(me.dynamicsymbols._t) - u[i] for i in range(n)]
     km = me.KanesMethod(world, q_ind=q, u_ind=u, kd_eqs=kd)
-    params = {g: 9.81}
+    return dict(km=km, particles=particles, loads=loads, q=q, u=u, m=m, l=l, k=k, c=c, g=g, world=world,
+                origin=origin, end=joint)
+
+
+def build(n):
+    parts = chain(n)
+    m, l, k, c = parts["m"], parts["l"], parts["k"], parts["c"]
+    params = {parts["g"]: 9.81}
     for i in range(n):  # mbsgen::planar_chain's defaults
         params.update({m[i]: 1.0, l[i]: 0.5, k[i]: 10.0, c[i]: 0.1})
-    return km, particles, loads, q, u, params
+    return parts["km"], parts["particles"], parts["loads"], parts["q"], parts["u"], params
 
 
 def plain(q, u):
