@@ -36,7 +36,7 @@ log() { printf '[bench %4ds] %s\n' $(( $(date +%s) - start )) "$*" >&2; }
 
 # ---- dependencies -------------------------------------------------------------------------------
 scripts/deps.sh
-extra=(python3-sympy python3-scipy octave octave-control libbenchmark-dev gnuplot-nox libmujoco-dev liborocos-kdl-dev)
+extra=(python3-sympy python3-scipy octave octave-control libbenchmark-dev gnuplot-nox libmujoco-dev liborocos-kdl-dev libkdl-parser-dev)
 missing=()
 for p in "${extra[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -147,6 +147,14 @@ for d in "$out"/modes_data/*/; do
     echo "octave,$name,,,timeout,nan,nan" >>"$out/octave_modes.csv"
 done
 bench/engines.sh --build "$build" --out "$out" --jobs "$jobs" "${q[@]}" || log "engines: failed (see $out/engines.log)"
+# The URDF robots (issue 43, docs/urdf.md): our kernels against MuJoCo and KDL, per call.
+log "urdf_engines: the five URDF robots against MuJoCo and KDL"
+if cmake --build "$build" --target urdf_engines -j "$jobs" >"$out/urdf_engines_build.log" 2>&1; then
+  bench/urdf_speed.sh "$build/bench/urdf_engines" --processes 5 --out "$out/urdf_speed" >"$out/urdf_speed.md" 2>"$out/urdf_speed.log" ||
+    log "urdf_speed: failed (see $out/urdf_speed.log)"
+else
+  log "urdf_engines: not built (see $out/urdf_engines_build.log)"
+fi
 # Time simulation (issue 18 §2–4): tones against the frequency response and the middle ear's growth
 # with the level (about 7 min), simulate() timed (about 1 min), SciPy's solve_ivp through the same
 # kernels (about 15 min).
