@@ -219,6 +219,27 @@ def test_a_tape_file_directly(tmp_path):
     assert np.array_equal(direct.modes().eigenvalues, cached.modes().eigenvalues)
 
 
+def test_a_robot_from_its_urdf(tmp_path):
+    """A .urdf is a model file too (docs/urdf.md): the Panda's seven joints in the file's order; the
+    import with elastic joints gives seven oscillatory modes (one of each pair listed), stable, and the same
+    numbers as the command line's `modes` of the same imported file."""
+    arm = mbsgen.Model(os.path.join(SOURCE, "models/robots/urdf/panda.urdf"))
+    assert arm.coordinates == ["panda_joint%d" % k for k in range(1, 8)]
+    assert arm.evaluation == "tape"
+    yaml = tmp_path / "panda_elastic.yaml"
+    subprocess.run([TOOL, "import", os.path.join(SOURCE, "models/robots/urdf/panda.urdf"), "--elastic", "all",
+                    "--pose", "panda_joint4=-1.8", "--out", str(yaml)], check=True, stderr=subprocess.DEVNULL)
+    modes = mbsgen.Model(yaml).modes()
+    assert modes.stability == "stable"
+    assert len(modes.eigenvalues) == 7 and np.all(modes.eigenvalues.imag > 0)  # one of each pair
+    cli = json.loads(subprocess.run([TOOL, "run", str(yaml), "--", "modes", "--format", "json"], check=True,
+                                    capture_output=True, text=True).stdout)
+    ours = sorted((z for z in modes.eigenvalues if z.imag > 0), key=lambda z: z.imag)
+    theirs = sorted((complex(m["lambda_re"], m["lambda_im"]) for m in cli["modes"] if m["lambda_im"] > 0),
+                    key=lambda z: z.imag)
+    assert np.array_equal(np.array(ours), np.array(theirs))
+
+
 def resident_kib():
     with open("/proc/self/statm", encoding="ascii") as f:
         return int(f.read().split()[1]) * resource.getpagesize() // 1024
