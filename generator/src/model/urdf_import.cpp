@@ -952,8 +952,8 @@ void Importer::check_mimics_and_options() {
 
 UrdfImport Importer::run() {
   parse_xml();
+  check_tree();  // first: urdfdom 3.0 leaks the links of a cycle it was given
   check_with_urdfdom();
-  check_tree();
   check_mimics_and_options();
   symbols_.reserve("g");  // gravity's magnitude
   for (const auto& name : link_order_) links_.at(name).id = entities_.take(name, &notes_, "link");

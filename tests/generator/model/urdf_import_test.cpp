@@ -345,7 +345,11 @@ TEST(UrdfImport, RefusesWithTheLine) {
       << error_of(flat);
   const std::string missing = "<robot name=\"r\"><link name=\"base\"/>\n"
                               "<joint name=\"q\" type=\"continuous\"><parent link=\"base\"/><child link=\"nowhere\"/></joint></robot>";
-  EXPECT_NE(error_of(missing).find("test.urdf:2:1: error: urdfdom:"), std::string::npos) << error_of(missing);
+  EXPECT_NE(error_of(missing).find("test.urdf:2:1: error: joint 'q': no link 'nowhere'"), std::string::npos)
+      << error_of(missing);
+  const std::string bad_type = "<robot name=\"r\"><link name=\"base\"/><link name=\"a\"/>\n"
+                               "<joint name=\"q\" type=\"hinge\"><parent link=\"base\"/><child link=\"a\"/></joint></robot>";
+  EXPECT_NE(error_of(bad_type).find("test.urdf:2:1: error: urdfdom:"), std::string::npos) << error_of(bad_type);
   const std::string mimic = "<robot name=\"r\"><link name=\"base\"/><link name=\"a\"/>\n"
                             "<joint name=\"q\" type=\"continuous\"><parent link=\"base\"/><child link=\"a\"/>\n"
                             "  <mimic joint=\"ghost\"/></joint></robot>";
