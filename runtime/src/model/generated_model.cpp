@@ -202,8 +202,24 @@ OperatingPoint GeneratedModel::operating_point() const {
   const Eigen::VectorXd ydd0 = Eigen::VectorXd::Zero(f);
   const std::vector<double> u0(static_cast<std::size_t>(std::max<Eigen::Index>(m, 1)), 0.0);
   StaticEquilibrium newton(f);
+  bool at_guess = true;
   newton.compute(
-      [&](const Eigen::VectorXd& y, Eigen::VectorXd& res) { res = residual(y, yd0); },
+      [&](const Eigen::VectorXd& y, Eigen::VectorXd& res) {
+        // At the guess a kernel that cannot evaluate is the model's error (its message stands); at a
+        // trial point of the line search it is a step too far: a non-finite residual, which the
+        // search halves (a full Newton step from a nearly singular K can leave where the kernels
+        // are finite).
+        if (at_guess) {
+          at_guess = false;
+          res = residual(y, yd0);
+          return;
+        }
+        try {
+          res = residual(y, yd0);
+        } catch (const NonFiniteError&) {
+          res = Eigen::VectorXd::Constant(f, std::numeric_limits<double>::quiet_NaN());
+        }
+      },
       [&](const Eigen::VectorXd& y, Eigen::MatrixXd& J) {
         J.resize(f, f);
         if (k_.linear) {
