@@ -24,6 +24,7 @@
 // writes OUT_DIR/engines.csv, OUT_DIR/engines_agreement.csv and the MJCF files it loaded
 // (OUT_DIR/engines_mjcf/*.xml).
 #include "harness.hpp"
+#include "mujoco_engine.hpp"
 #include "puma560.hpp"
 #include "spatial_chain_12.hpp"
 #include "spatial_chain_3.hpp"
@@ -34,7 +35,6 @@
 #include <kdl/chain.hpp>
 #include <kdl/chaindynparam.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
-#include <mujoco/mujoco.h>
 
 #include <algorithm>
 #include <cmath>
@@ -237,51 +237,7 @@ std::string mjcf(const ChainModel& model, const std::string& name) {
   return x.str();
 }
 
-struct MuJoCo {
-  mjModel* m = nullptr;
-  mjData* d = nullptr;
-  std::vector<double> M;  // dense, nv × nv
-
-  MuJoCo(const std::string& xml_path) {
-    char error[1000] = "";
-    m = mj_loadXML(xml_path.c_str(), nullptr, error, sizeof error);
-    if (!m) throw std::runtime_error("MuJoCo cannot load " + xml_path + ": " + error);
-    d = mj_makeData(m);
-    M.resize(static_cast<std::size_t>(m->nv * m->nv));
-  }
-  ~MuJoCo() {
-    if (d) mj_deleteData(d);
-    if (m) mj_deleteModel(m);
-  }
-  MuJoCo(const MuJoCo&) = delete;
-  MuJoCo& operator=(const MuJoCo&) = delete;
-
-  void mass_matrix(const double* q) {
-    mju_copy(d->qpos, q, m->nq);
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_crb(m, d);
-    mj_fullM(m, M.data(), d->qM);
-  }
-  void bias(const double* q, const double* qd) {
-    mju_copy(d->qpos, q, m->nq);
-    mju_copy(d->qvel, qd, m->nv);
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_comVel(m, d);
-    mj_rne(m, d, 0, d->qfrc_bias);
-  }
-  void both(const double* q, const double* qd) {
-    mju_copy(d->qpos, q, m->nq);
-    mju_copy(d->qvel, qd, m->nv);
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_crb(m, d);
-    mj_fullM(m, M.data(), d->qM);
-    mj_comVel(m, d);
-    mj_rne(m, d, 0, d->qfrc_bias);
-  }
-};
+using bench::MuJoCo;
 
 // ---- Orocos KDL ---------------------------------------------------------------------------------
 
@@ -467,60 +423,8 @@ double check_agreement(Engines& e, bench::Csv& csv) {
 
 // ---- timing -------------------------------------------------------------------------------------
 
-/// A timed quantity: `run(calls)` makes `calls` calls, cycling through the states.
-struct Timed {
-  std::string engine, quantity;
-  std::function<void(long)> run;
-  double agreement = 0;
-  std::size_t ops = 0;
-  bench::Timing t;
-};
-
-/// This thread's CPU time [s]. The kernels and the engines compute on one thread without
-/// waiting, so its CPU time is their time without the intervals in which the shared machine ran
-/// something else on this core (wall-clock medians were off by factors at load 6 on 2 cores).
-double thread_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-/// Sizes a batch of each to at least min_batch_s, then times `repetitions` batches of each in
-/// round robin, in thread CPU time; per call, the median and spread of the batches (bench::Timing).
-void time_interleaved(std::vector<Timed>& timed, int repetitions, double min_batch_s) {
-  std::vector<std::vector<double>> per_call(timed.size());
-  for (Timed& x : timed) {
-    // A cold first call (the 30-link chain's kernels are 0.6 MB of code) or one interruption must
-    // not size the batch: a warm-up call, then the faster of two tries of each batch size.
-    x.run(1);
-    long calls = 1;
-    for (;;) {
-      double s = INFINITY;
-      for (int attempt = 0; attempt < 2; ++attempt) {
-        const double t0 = thread_seconds();
-        x.run(calls);
-        s = std::min(s, thread_seconds() - t0);
-      }
-      if (s >= min_batch_s / 4 || calls > (1L << 30)) {
-        x.t.calls_per_repetition = std::max(1L, static_cast<long>(std::ceil(calls * min_batch_s / std::max(s, 1e-9))));
-        break;
-      }
-      calls *= 4;
-    }
-    x.t.repetitions = repetitions;
-  }
-  for (int rep = 0; rep < repetitions; ++rep)
-    for (std::size_t i = 0; i < timed.size(); ++i) {
-      const double t0 = thread_seconds();
-      timed[i].run(timed[i].t.calls_per_repetition);
-      per_call[i].push_back((thread_seconds() - t0) / static_cast<double>(timed[i].t.calls_per_repetition));
-    }
-  for (std::size_t i = 0; i < timed.size(); ++i) {
-    timed[i].t.median = bench::median_of(per_call[i]);
-    timed[i].t.min = *std::min_element(per_call[i].begin(), per_call[i].end());
-    timed[i].t.max = *std::max_element(per_call[i].begin(), per_call[i].end());
-  }
-}
+using bench::Timed;
+using bench::time_interleaved;
 
 /// The operation count of one of our kernels, from the manifest <dir>/<id>.json (0 when absent).
 std::size_t kernel_operations(const std::string& id, const std::string& kernel) {

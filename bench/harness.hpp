@@ -10,6 +10,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -108,6 +110,64 @@ inline std::vector<int> parse_int_list(const std::string& text) {
     start = end + 1;
   }
   return v;
+}
+
+// ---- engines against our kernels, interleaved (bench/engines_bench.cpp, bench/urdf_engines.cpp) --
+
+/// This thread's CPU time [s]. The kernels and the engines compute on one thread without waiting,
+/// so its CPU time is their time without the intervals in which the shared machine ran something
+/// else on this core (wall-clock medians were off by factors at load 6 on 2 cores).
+inline double thread_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+/// A timed quantity: `run(calls)` makes `calls` calls, cycling through the states.
+struct Timed {
+  std::string engine, quantity;
+  std::function<void(long)> run;
+  double agreement = 0;  ///< against the reference, where the caller keeps it here
+  std::size_t ops = 0;   ///< our kernel's operation count, where known
+  Timing t;
+};
+
+/// Sizes a batch of each to at least min_batch_s, then times `repetitions` batches of each in
+/// round robin, in thread CPU time; per call, the median and spread of the batches.
+inline void time_interleaved(std::vector<Timed>& timed, int repetitions, double min_batch_s) {
+  std::vector<std::vector<double>> per_call(timed.size());
+  for (Timed& x : timed) {
+    // A cold first call (the 30-link chain's kernels are 0.6 MB of code) or one interruption must
+    // not size the batch: a warm-up call, then the faster of two tries of each batch size.
+    x.run(1);
+    long calls = 1;
+    for (;;) {
+      double s = INFINITY;
+      for (int attempt = 0; attempt < 2; ++attempt) {
+        const double t0 = thread_seconds();
+        x.run(calls);
+        s = std::min(s, thread_seconds() - t0);
+      }
+      if (s >= min_batch_s / 4 || calls > (1L << 30)) {
+        x.t.calls_per_repetition =
+            std::max(1L, static_cast<long>(std::ceil(static_cast<double>(calls) * min_batch_s / std::max(s, 1e-9))));
+        break;
+      }
+      calls *= 4;
+    }
+    x.t.repetitions = repetitions;
+  }
+  for (int rep = 0; rep < repetitions; ++rep)
+    for (std::size_t i = 0; i < timed.size(); ++i) {
+      const double t0 = thread_seconds();
+      timed[i].run(timed[i].t.calls_per_repetition);
+      per_call[i].push_back((thread_seconds() - t0) / static_cast<double>(timed[i].t.calls_per_repetition));
+    }
+  for (std::size_t i = 0; i < timed.size(); ++i) {
+    timed[i].t.median = median_of(per_call[i]);
+    timed[i].t.min = *std::min_element(per_call[i].begin(), per_call[i].end());
+    timed[i].t.max = *std::max_element(per_call[i].begin(), per_call[i].end());
+  }
 }
 
 }  // namespace bench

@@ -93,6 +93,7 @@
 //       -o /tmp/urdf_engines DIR/liburdf_kernels.a -lmujoco -lkdl_parser -lorocos-kdl -lurdfdom_model -ltinyxml2
 // bench/urdf_speed.sh runs --time over the five robots of models/robots/urdf and tabulates it.
 #include "harness.hpp"
+#include "mujoco_engine.hpp"
 
 #include <Eigen/Dense>
 #include <kdl/chain.hpp>
@@ -101,7 +102,6 @@
 #include <kdl/tree.hpp>
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
 #include <kdl_parser/kdl_parser.hpp>
-#include <mujoco/mujoco.h>
 #include <tinyxml2.h>
 #include <unistd.h>
 #include <urdf_parser/urdf_parser.h>
@@ -339,56 +339,7 @@ std::string with_placeholder_inertials(const std::string& text, const urdf::Mode
 
 // ---- MuJoCo -------------------------------------------------------------------------------------
 
-struct MuJoCo {
-  mjModel* m = nullptr;
-  mjData* d = nullptr;
-  std::vector<double> M;  // dense, nv × nv, row-major
-
-  explicit MuJoCo(const std::string& path) {
-    char error[1000] = "";
-    m = mj_loadXML(path.c_str(), nullptr, error, sizeof error);
-    if (!m) throw std::runtime_error("MuJoCo cannot load " + path + ": " + error);
-    d = mj_makeData(m);
-    M.resize(static_cast<std::size_t>(m->nv * m->nv));
-  }
-  ~MuJoCo() {
-    if (d) mj_deleteData(d);
-    if (m) mj_deleteModel(m);
-  }
-  MuJoCo(const MuJoCo&) = delete;
-  MuJoCo& operator=(const MuJoCo&) = delete;
-
-  void mass_matrix(const double* q) {
-    mju_copy(d->qpos, q, m->nq);
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_crb(m, d);
-    mj_fullM(m, M.data(), d->qM);
-  }
-  /// qfrc_bias at (q, q̇); q̇ = nullptr: at rest, the gravity forces.
-  void bias(const double* q, const double* qd) {
-    mju_copy(d->qpos, q, m->nq);
-    if (qd)
-      mju_copy(d->qvel, qd, m->nv);
-    else
-      mju_zero(d->qvel, m->nv);
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_comVel(m, d);
-    mj_rne(m, d, 0, d->qfrc_bias);
-  }
-  /// M and qfrc_bias at (q, q̇), the position stages shared.
-  void both(const double* q, const double* qd) {
-    mju_copy(d->qpos, q, m->nq);
-    mju_copy(d->qvel, qd, m->nv);
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_crb(m, d);
-    mj_fullM(m, M.data(), d->qM);
-    mj_comVel(m, d);
-    mj_rne(m, d, 0, d->qfrc_bias);
-  }
-};
+using bench::MuJoCo;
 
 // ---- Orocos KDL ---------------------------------------------------------------------------------
 
@@ -754,56 +705,8 @@ OursAgreement check_ours(Ours& o, MuJoCo& mj, std::size_t S) {
 
 // ---- timing (as bench/engines_bench.cpp) --------------------------------------------------------
 
-/// This thread's CPU time [s]: the engines compute on one thread without waiting, so it leaves out
-/// the intervals in which the shared machine ran something else on this core.
-double thread_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-struct Timed {
-  std::string engine, quantity;
-  std::function<void(long)> run;  ///< `calls` calls, cycling through the states
-  bench::Timing t;
-};
-
-/// Sizes a batch of each to at least min_batch_s (a warm-up call, then the faster of two tries of
-/// each batch size), then times `repetitions` batches of each in round robin; per call, the median
-/// and spread of the batches.
-void time_interleaved(std::vector<Timed>& timed, int repetitions, double min_batch_s) {
-  std::vector<std::vector<double>> per_call(timed.size());
-  for (Timed& x : timed) {
-    x.run(1);
-    long calls = 1;
-    for (;;) {
-      double s = INFINITY;
-      for (int attempt = 0; attempt < 2; ++attempt) {
-        const double t0 = thread_seconds();
-        x.run(calls);
-        s = std::min(s, thread_seconds() - t0);
-      }
-      if (s >= min_batch_s / 4 || calls > (1L << 30)) {
-        x.t.calls_per_repetition =
-            std::max(1L, static_cast<long>(std::ceil(static_cast<double>(calls) * min_batch_s / std::max(s, 1e-9))));
-        break;
-      }
-      calls *= 4;
-    }
-    x.t.repetitions = repetitions;
-  }
-  for (int rep = 0; rep < repetitions; ++rep)
-    for (std::size_t i = 0; i < timed.size(); ++i) {
-      const double t0 = thread_seconds();
-      timed[i].run(timed[i].t.calls_per_repetition);
-      per_call[i].push_back((thread_seconds() - t0) / static_cast<double>(timed[i].t.calls_per_repetition));
-    }
-  for (std::size_t i = 0; i < timed.size(); ++i) {
-    timed[i].t.median = bench::median_of(per_call[i]);
-    timed[i].t.min = *std::min_element(per_call[i].begin(), per_call[i].end());
-    timed[i].t.max = *std::max_element(per_call[i].begin(), per_call[i].end());
-  }
-}
+using bench::Timed;
+using bench::time_interleaved;
 
 // ---- command line -------------------------------------------------------------------------------
 
@@ -848,49 +751,58 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-int run(const Options& opt) {
-  std::ifstream in(opt.urdf, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + opt.urdf);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const UrdfFacts facts = urdf_facts(text);
-  std::vector<std::string> notes;
-  auto note = [&notes](const std::string& s) {
-    notes.push_back(s);
+/// The notes of a run: kept for the CSV's header and said on stderr as they come.
+struct Notes {
+  std::vector<std::string> lines;
+  void operator()(const std::string& s) {
+    lines.push_back(s);
     std::fprintf(stderr, "urdf_engines: note: %s\n", s.c_str());
-  };
-
-  // MuJoCo: its joints in qpos order, each 1-dof, and nothing added to M or the bias. It loads the
-  // URDF itself, or a copy with placeholder inertials (with_placeholder_inertials).
-  std::vector<std::string> patched;
-  const std::string patched_text = with_placeholder_inertials(text, *facts.model, patched);
-  std::unique_ptr<MuJoCo> mj_owner;
-  if (patched.empty()) {
-    mj_owner = std::make_unique<MuJoCo>(opt.urdf);
-  } else {
-    std::string s;
-    for (const auto& l : patched) s += (s.empty() ? "" : " ") + l;
-    note("MuJoCo 2.2 refuses moving bodies without mass or inertia; placeholder inertials given to it for " + s +
-         ", replaced by the URDF's after loading");
-    const std::filesystem::path copy = std::filesystem::temp_directory_path() /
-                                       ("urdf_engines_" + std::to_string(getpid()) + ".urdf");
-    std::ofstream(copy, std::ios::binary) << patched_text;
-    try {
-      mj_owner = std::make_unique<MuJoCo>(copy.string());
-    } catch (...) {
-      std::filesystem::remove(copy);
-      throw;
-    }
-    std::filesystem::remove(copy);
   }
-  const UrdfFacts loaded = patched.empty() ? facts : urdf_facts(patched_text);  // what MuJoCo was given
-  MuJoCo& mj = *mj_owner;
-  const mjModel* m = mj.m;
+};
+
+/// MuJoCo with the URDF: the file itself, or a copy with placeholder inertials for the massless
+/// moving links MuJoCo 2.2 refuses (with_placeholder_inertials), written to a file created
+/// exclusively with an unpredictable name and removed once loaded. `loaded`: what it was given.
+std::unique_ptr<MuJoCo> load_mujoco(const Options& opt, const std::string& text, const UrdfFacts& facts,
+                                    std::vector<std::string>& patched, UrdfFacts& loaded, Notes& note) {
+  const std::string patched_text = with_placeholder_inertials(text, *facts.model, patched);
+  if (patched.empty()) {
+    loaded = facts;
+    return std::make_unique<MuJoCo>(opt.urdf);
+  }
+  std::string s;
+  for (const auto& l : patched) s += (s.empty() ? "" : " ") + l;
+  note("MuJoCo 2.2 refuses moving bodies without mass or inertia; placeholder inertials given to it for " + s +
+       ", replaced by the URDF's after loading");
+  std::string path = (std::filesystem::temp_directory_path() / "urdf_engines_XXXXXX.urdf").string();
+  const int fd = mkstemps(path.data(), 5);
+  if (fd < 0) throw std::runtime_error("cannot create a temporary file for MuJoCo's copy of " + opt.urdf);
+  const bool written = ::write(fd, patched_text.data(), patched_text.size()) == static_cast<ssize_t>(patched_text.size());
+  ::close(fd);
+  std::unique_ptr<MuJoCo> mj;
+  try {
+    if (!written) throw std::runtime_error("cannot write MuJoCo's copy of " + opt.urdf);
+    mj = std::make_unique<MuJoCo>(path);
+  } catch (...) {
+    std::filesystem::remove(path);
+    throw;
+  }
+  std::filesystem::remove(path);
+  loaded = urdf_facts(patched_text);
+  return mj;
+}
+
+/// MuJoCo's joints in qpos order (names, joint ids), each a hinge or slide; armature, damping,
+/// friction loss and stiffness set to zero (none is in M or qfrc_bias, armature aside), said.
+void joints_of_mujoco(MuJoCo& mj, const UrdfFacts& facts, std::vector<std::string>& names, std::vector<int>& joint_of,
+                      Notes& note) {
+  mjModel* m = mj.m;
   const int n = m->nq;
+  names.assign(static_cast<std::size_t>(n), "");
+  joint_of.assign(static_cast<std::size_t>(n), 0);
   if (m->nv != n || m->njnt != n)
     throw std::runtime_error("MuJoCo made " + std::to_string(m->njnt) + " joints, " + std::to_string(m->nq) +
                              " positions, " + std::to_string(m->nv) + " velocities: not all joints are 1-dof");
-  std::vector<std::string> names(static_cast<std::size_t>(n));
-  std::vector<int> joint_of(static_cast<std::size_t>(n));  // qpos index → joint id
   for (int j = 0; j < m->njnt; ++j) {
     const char* name = mj_id2name(m, mjOBJ_JOINT, j);
     if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
@@ -923,6 +835,12 @@ int run(const Options& opt) {
     note("links without mass below a moving joint: " + s);
   }
 
+}
+
+/// Each MuJoCo body's mass properties recomputed from the URDF, compared and written back.
+void restore_mass_properties(MuJoCo& mj, const UrdfFacts& facts, const UrdfFacts& loaded,
+                             const std::vector<std::string>& patched, Notes& note) {
+  mjModel* m = mj.m;
   // Masses: MuJoCo's bodies against the URDF's moving links, in total and body by body. MuJoCo's
   // compiler diagonalizes each body's inertia (a URDF's off-diagonal terms, and the sum of fused
   // links) with a Jacobi iteration, mju_eig3, that stops when the next rotation's cosine is within
@@ -987,9 +905,11 @@ int run(const Options& opt) {
        "), its centres of mass by up to " + num3(worst_com) +
        " m; replaced by the URDF's, diagonalized in double (Eigen)");
 
-  // KDL, with MuJoCo's gravity; joints matched by name.
-  const KDL::Vector g(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]);
-  Kdl kdl(opt.urdf, g);
+}
+
+/// KDL's joint numbers of MuJoCo's qpos order (the sets must be equal).
+std::vector<unsigned> match_kdl(Kdl& kdl, const std::vector<std::string>& names, Notes& note) {
+  const int n = static_cast<int>(names.size());
   const std::map<std::string, unsigned> kdl_numbers = kdl.joint_numbers();
   std::vector<unsigned> kdl_index(static_cast<std::size_t>(n));  // qpos index → KDL joint number
   {
@@ -1015,11 +935,17 @@ int run(const Options& opt) {
   note(std::string("KDL tree: ") + std::to_string(kdl.tree.getNrOfSegments()) + " segments, " +
        (kdl.chain ? "a single chain: ChainDynParam compared too" : "branched: TreeIdSolver_RNE only"));
 
-  // The states.
-  const auto N = static_cast<std::size_t>(n);
-  const auto S = static_cast<std::size_t>(opt.samples);
-  std::vector<double> Q(S * N), QD(S * N);
-  std::vector<std::string> ranges(N);
+  return kdl_index;
+}
+
+/// The sampled states, q within each joint's limits (or its default range) and q̇ in [−2, 2],
+/// and a line per joint saying which range it was.
+void sample_states(const mjModel* m, const std::vector<int>& joint_of, const Options& opt, std::vector<double>& Q,
+                   std::vector<double>& QD, std::vector<std::string>& ranges) {
+  const std::size_t N = joint_of.size(), S = static_cast<std::size_t>(opt.samples);
+  Q.assign(S * N, 0.0);
+  QD.assign(S * N, 0.0);
+  ranges.assign(N, "");
   {
     std::mt19937_64 rng(opt.seed);
     std::vector<std::uniform_real_distribution<double>> position;
@@ -1047,17 +973,32 @@ int run(const Options& opt) {
       for (std::size_t i = 0; i < N; ++i) QD[s * N + i] = rate(rng);
     }
   }
+}
+
+/// What MuJoCo recorded and how far KDL is from it.
+struct Recorded {
+  std::vector<double> M, bias, gravity;
+  double worst_M = 0, worst_bias = 0, worst_gravity = 0, worst_chain = 0;
+};
+
+/// Both engines on every state; MuJoCo's numbers kept.
+Recorded record(MuJoCo& mj, Kdl& kdl, const std::vector<unsigned>& kdl_index, const std::vector<double>& Q,
+                const std::vector<double>& QD, std::size_t S) {
+  const std::size_t N = kdl_index.size();
+  Recorded rec;
+  rec.M.assign(S * N * N, 0.0);
+  rec.bias.assign(S * N, 0.0);
+  rec.gravity.assign(S * N, 0.0);
+  std::vector<double> &rec_M = rec.M, &rec_bias = rec.bias, &rec_gravity = rec.gravity;
+  double &worst_M = rec.worst_M, &worst_bias = rec.worst_bias, &worst_gravity = rec.worst_gravity,
+         &worst_chain = rec.worst_chain;
+  std::vector<double> kM(N * N), kv(N);
   auto to_kdl = [&](std::size_t s) {
     for (std::size_t i = 0; i < N; ++i) {
       kdl.q(kdl_index[i]) = Q[s * N + i];
       kdl.qd(kdl_index[i]) = QD[s * N + i];
     }
   };
-
-  // Both engines on every state; MuJoCo's numbers kept.
-  std::vector<double> rec_M(S * N * N), rec_bias(S * N), rec_gravity(S * N);
-  double worst_M = 0, worst_bias = 0, worst_gravity = 0, worst_chain = 0;
-  std::vector<double> kM(N * N), kv(N);
   for (std::size_t s = 0; s < S; ++s) {
     const double *q = &Q[s * N], *qd = &QD[s * N];
     mj.mass_matrix(q);
@@ -1089,25 +1030,17 @@ int run(const Options& opt) {
       worst_chain = std::max({worst_chain, cM, cb, cg});
     }
   }
-  std::fprintf(stderr,
-               "urdf_engines: %s, %d joints, %d samples: worst relative disagreement KDL (TreeIdSolver_RNE) vs "
-               "MuJoCo: M %.3g, bias %.3g, gravity %.3g",
-               facts.robot.c_str(), n, opt.samples, worst_M, worst_bias, worst_gravity);
-  if (kdl.chain) std::fprintf(stderr, "; KDL ChainDynParam vs MuJoCo (M, bias, gravity) %.3g", worst_chain);
-  std::fprintf(stderr, " (tolerance %.3g)\n", opt.tolerance);
-  if (std::max({worst_M, worst_bias, worst_gravity, worst_chain}) > opt.tolerance) {
-    std::fprintf(stderr, "urdf_engines: the engines disagree beyond the tolerance; %s not written\n",
-                 opt.out.c_str());
-    return 1;
-  }
+  return rec;
+}
 
-  // OUT.csv, all or nothing; the three readers (urdfdom here, MuJoCo, kdl_parser) read the file
-  // separately, so it must not have changed meanwhile.
-  {
-    std::ifstream again(opt.urdf, std::ios::binary);
-    const std::string now((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
-    if (now != text) throw std::runtime_error("the URDF changed while it was read; run again");
-  }
+/// OUT.csv, all or nothing.
+void write_csv(const Options& opt, const std::string& text, const UrdfFacts& facts, const mjModel* m, const Kdl& kdl,
+               const std::vector<std::string>& names, const std::vector<std::string>& ranges, const Notes& notes,
+               const std::vector<double>& Q, const std::vector<double>& QD, const Recorded& rec) {
+  const std::size_t N = names.size(), S = static_cast<std::size_t>(opt.samples);
+  const std::vector<double> &rec_M = rec.M, &rec_bias = rec.bias, &rec_gravity = rec.gravity;
+  const double worst_M = rec.worst_M, worst_bias = rec.worst_bias, worst_gravity = rec.worst_gravity,
+               worst_chain = rec.worst_chain;
   const std::string tmp = opt.out + ".tmp";
   {
     std::ofstream f(tmp, std::ios::binary);
@@ -1130,7 +1063,7 @@ int run(const Options& opt) {
       << "# gravity: " << num17(m->opt.gravity[0]) << " " << num17(m->opt.gravity[1]) << " "
       << num17(m->opt.gravity[2]) << " m/s^2 (world frame; MuJoCo's default, given to KDL)\n";
     for (std::size_t i = 0; i < N; ++i) f << "# joint " << i << ": " << names[i] << ", q: " << ranges[i] << "\n";
-    for (const std::string& s : notes) f << "# note: " << s << "\n";
+    for (const std::string& s : notes.lines) f << "# note: " << s << "\n";
     f << "# worst relative disagreement KDL vs MuJoCo over the samples (max |difference| / max |MuJoCo| per sample): M "
       << num3(worst_M) << ", bias " << num3(worst_bias) << ", gravity " << num3(worst_gravity);
     if (kdl.chain) f << "; ChainDynParam " << num3(worst_chain);
@@ -1162,8 +1095,15 @@ int run(const Options& opt) {
   std::filesystem::rename(tmp, opt.out);
   std::fprintf(stderr, "urdf_engines: wrote %s\n", opt.out.c_str());
 
-  if (!opt.time) return 0;
+}
 
+/// --time: ours (when compiled in), MuJoCo and KDL, checked and then timed on the same states.
+int time_engines(const Options& opt, const UrdfFacts& facts, MuJoCo& mj, Kdl& kdl, const std::vector<std::string>& names,
+                 const std::vector<unsigned>& kdl_index, const std::vector<double>& Q, const std::vector<double>& QD,
+                 const Recorded& rec) {
+  const std::size_t N = names.size(), S = static_cast<std::size_t>(opt.samples);
+  const double worst_M = rec.worst_M, worst_bias = rec.worst_bias, worst_gravity = rec.worst_gravity,
+               worst_chain = rec.worst_chain;
   // Ours, when the robot's kernels are compiled in (see the head of the file).
   std::unique_ptr<Ours> ours;
   {
@@ -1294,6 +1234,54 @@ int run(const Options& opt) {
                 a == agreement.end() ? "" : num3(a->second).c_str());
   }
   return 0;
+}
+
+int run(const Options& opt) {
+  std::ifstream in(opt.urdf, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + opt.urdf);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const UrdfFacts facts = urdf_facts(text);
+  Notes note;
+  std::vector<std::string> patched;
+  UrdfFacts loaded;
+  const std::unique_ptr<MuJoCo> mj = load_mujoco(opt, text, facts, patched, loaded, note);
+  std::vector<std::string> names;
+  std::vector<int> joint_of;  // qpos index → joint id
+  joints_of_mujoco(*mj, facts, names, joint_of, note);
+  restore_mass_properties(*mj, facts, loaded, patched, note);
+  const mjModel* m = mj->m;
+  const int n = m->nq;
+
+  // KDL, with MuJoCo's gravity; joints matched by name.
+  const KDL::Vector g(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]);
+  Kdl kdl(opt.urdf, g);
+  const std::vector<unsigned> kdl_index = match_kdl(kdl, names, note);
+
+  std::vector<double> Q, QD;
+  std::vector<std::string> ranges;
+  sample_states(m, joint_of, opt, Q, QD, ranges);
+  const Recorded rec = record(*mj, kdl, kdl_index, Q, QD, static_cast<std::size_t>(opt.samples));
+  std::fprintf(stderr,
+               "urdf_engines: %s, %d joints, %d samples: worst relative disagreement KDL (TreeIdSolver_RNE) vs "
+               "MuJoCo: M %.3g, bias %.3g, gravity %.3g",
+               facts.robot.c_str(), n, opt.samples, rec.worst_M, rec.worst_bias, rec.worst_gravity);
+  if (kdl.chain) std::fprintf(stderr, "; KDL ChainDynParam vs MuJoCo (M, bias, gravity) %.3g", rec.worst_chain);
+  std::fprintf(stderr, " (tolerance %.3g)\n", opt.tolerance);
+  if (std::max({rec.worst_M, rec.worst_bias, rec.worst_gravity, rec.worst_chain}) > opt.tolerance) {
+    std::fprintf(stderr, "urdf_engines: the engines disagree beyond the tolerance; %s not written\n",
+                 opt.out.c_str());
+    return 1;
+  }
+  // The three readers (urdfdom here, MuJoCo, kdl_parser) read the file separately, so it must not
+  // have changed meanwhile.
+  {
+    std::ifstream again(opt.urdf, std::ios::binary);
+    const std::string now((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
+    if (now != text) throw std::runtime_error("the URDF changed while it was read; run again");
+  }
+  write_csv(opt, text, facts, m, kdl, names, ranges, note, Q, QD, rec);
+  if (!opt.time) return 0;
+  return time_engines(opt, facts, *mj, kdl, names, kdl_index, Q, QD, rec);
 }
 
 }  // namespace

@@ -164,7 +164,8 @@ int run_command(int argc, char** argv) {
 
 // `mbsgen import FILE.urdf [--out MODEL.yaml] [options]`: the URDF as a model file (docs/urdf.md).
 struct ImportRequest {
-  std::string file, out, base = "fixed", elastic_text, pose_text, output_text;
+  std::string file, out, base = "fixed";
+  std::vector<std::string> elastic, pose, outputs;
   std::vector<double> gravity{0, 0, -9.81};
   double stiffness = 1e4, damping = 10;
   bool no_inputs = false;
@@ -178,36 +179,36 @@ void add_import_options(CLI::App& app, ImportRequest& r) {
                                    "(six coordinates)")
       ->check(CLI::IsMember({"fixed", "floating"}));
   app.add_option("--gravity", r.gravity, "gravity in the world frame, m/s^2 (default 0 0 -9.81)")->expected(3);
-  app.add_option("--elastic", r.elastic_text, "joints with a joint spring and damper (series elastic), comma-separated, "
-                                              "or all");
+  app.add_option("--elastic", r.elastic, "joints with a joint spring and damper (series elastic), comma-separated, "
+                                         "or all")
+      ->delimiter(',');
   app.add_option("--stiffness", r.stiffness, "each elastic joint's stiffness, N m/rad or N/m (default 1e4)");
   app.add_option("--damping", r.damping, "each elastic joint's damping, N m s/rad or N s/m (default 10)");
-  app.add_option("--output", r.output_text, "links whose origins' position and velocity are outputs, comma-separated "
-                                            "(default: the leaf links)");
-  app.add_option("--pose", r.pose_text, "joint values JOINT=VALUE,... of the pose: the operating point's guess and "
-                                        "the springs' rest (default 0)");
+  app.add_option("--output", r.outputs, "links whose origins' position and velocity are outputs, comma-separated "
+                                        "(default: the leaf links)")
+      ->delimiter(',');
+  app.add_option("--pose", r.pose, "joint values JOINT=VALUE,... of the pose: the operating point's guess and "
+                                   "the springs' rest (default 0)")
+      ->delimiter(',');
   app.add_flag("--no-inputs", r.no_inputs, "no torque (force) inputs at the joints");
 }
 
-std::vector<std::string> split_commas(const std::string& s) {
-  std::vector<std::string> out;
-  std::string item;
-  std::istringstream in(s);
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
+// CLI11 splits the lists at commas; empty items ("a,,b") are dropped.
+std::vector<std::string> nonempty(std::vector<std::string> v) {
+  v.erase(std::remove(v.begin(), v.end(), std::string()), v.end());
+  return v;
 }
 
 int import_command(const ImportRequest& r) {
   mbsgen::UrdfImportOptions o;
   o.floating_base = r.base == "floating";
   for (int k = 0; k < 3; ++k) o.gravity[k] = r.gravity[k];
-  o.elastic = split_commas(r.elastic_text);
+  o.elastic = nonempty(r.elastic);
   o.stiffness = r.stiffness;
   o.damping = r.damping;
-  o.outputs = split_commas(r.output_text);
+  o.outputs = nonempty(r.outputs);
   o.inputs = !r.no_inputs;
-  for (const auto& item : split_commas(r.pose_text)) {
+  for (const auto& item : nonempty(r.pose)) {
     const auto eq = item.find('=');
     std::size_t used = 0;
     double v = 0;

@@ -115,7 +115,6 @@ class Names {
     return name;
   }
   void reserve(const std::string& name) { used_.insert(name); }
-  bool has(const std::string& name) const { return used_.count(name) > 0; }
 
  private:
   std::set<std::string> used_;
@@ -193,7 +192,6 @@ struct Joint {
 
 struct Body {
   std::string name, parent, translation, rotation, source;  // rotation: "rotation: [..]" or "rotation_matrix: .."
-  std::vector<std::string> contributors;                      // links whose mass it carries
 };
 
 class Importer {
@@ -356,6 +354,13 @@ void Importer::check_with_urdfdom() {
   fail(at, "urdfdom: " + message);
 }
 
+// One number of an attribute, all of `w`: xs:double's optional sign, no locale; finite.
+bool finite_number(const std::string& w, double& x) {
+  const std::size_t skip = w.size() > 1 && w[0] == '+' ? 1 : 0;
+  const auto r = std::from_chars(w.data() + skip, w.data() + w.size(), x);
+  return r.ec == std::errc() && r.ptr == w.data() + w.size() && std::isfinite(x);
+}
+
 Vec Importer::numbers(const TiXmlElement* e, const char* attribute, const Vec& fallback) const {
   const char* text = e ? e->Attribute(attribute) : nullptr;
   if (!text) return fallback;
@@ -363,9 +368,7 @@ Vec Importer::numbers(const TiXmlElement* e, const char* attribute, const Vec& f
   std::vector<double> v;
   for (std::string w; in >> w;) {
     double x = 0;
-    const std::size_t skip = w.size() > 1 && w[0] == '+' ? 1 : 0;  // xs:double allows a sign
-    const auto r = std::from_chars(w.data() + skip, w.data() + w.size(), x);
-    if (r.ec != std::errc() || r.ptr != w.data() + w.size() || !std::isfinite(x))
+    if (!finite_number(w, x))
       fail(e, std::string(attribute) + "=\"" + comment(text) + "\": '" + comment(w) + "' is not a finite number");
     v.push_back(x);
   }
@@ -380,9 +383,7 @@ double Importer::number(const TiXmlElement* e, const char* attribute, double fal
   w.erase(0, w.find_first_not_of(" \t\r\n"));
   w.erase(w.find_last_not_of(" \t\r\n") + 1);
   double x = 0;
-  const std::size_t skip = w.size() > 1 && w[0] == '+' ? 1 : 0;
-  const auto r = std::from_chars(w.data() + skip, w.data() + w.size(), x);
-  if (r.ec != std::errc() || r.ptr != w.data() + w.size() || !std::isfinite(x))
+  if (!finite_number(w, x))
     fail(e, std::string(attribute) + "=\"" + comment(text) + "\" is not a finite number");
   return x;
 }
@@ -672,7 +673,6 @@ void Importer::compose_masses() {
       mc += l->mass * c;
       from += std::string(from.empty() ? "" : " + ") + "link '" + comment(l->raw) + "' <inertial> (" +
               where(l->inertial_line) + ")";
-      body.contributors.push_back(l->raw);
     }
     const Vec c = parts.size() == 1 ? parts[0].first : Vec(mc / m);  // one link: its own numbers, unrounded
     Mat inertia = Mat::Zero();
